@@ -1,0 +1,45 @@
+//! The environment contract (Gymnasium 1.x semantics).
+
+use std::collections::BTreeMap;
+
+use thiserror::Error;
+
+use crate::spaces::BoxSpace;
+
+/// Extra facts of a reset or step: at least `t`, force coefficients and the physical actuation
+/// for flow environments. Ordered map so that serialised output is deterministic.
+pub type Info = BTreeMap<String, f64>;
+
+/// What one `step` returns.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepResult {
+    pub obs: Vec<f64>,
+    pub reward: f64,
+    /// A real terminal state (e.g. the solver diverged).
+    pub terminated: bool,
+    /// True exactly on the episode's last action.
+    pub truncated: bool,
+    pub info: Info,
+}
+
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum EnvError {
+    #[error("action has {got} components, the action space has {expected}")]
+    ActionShape { expected: usize, got: usize },
+    #[error("action component {index} is {value}: actions must be finite numbers in [-1, 1]")]
+    NonFiniteAction { index: usize, value: f64 },
+    #[error("step called before reset (or after the episode ended): call reset first")]
+    NeedsReset,
+    #[error("{0}")]
+    Backend(String),
+}
+
+/// A reinforcement-learning environment.
+pub trait Env {
+    fn observation_space(&self) -> BoxSpace;
+    fn action_space(&self) -> BoxSpace;
+    /// Starts an episode; the same seed gives the same initial observation, bitwise.
+    fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError>;
+    /// Applies one action for one control interval.
+    fn step(&mut self, action: &[f64]) -> Result<StepResult, EnvError>;
+}

@@ -1,0 +1,31 @@
+//! Force on bodies by momentum exchange, Galilean-invariant form of Wen, Zhang, Tu, Wang & Fang,
+//! J. Comput. Phys. 266 (2014): for every link from fluid node `x` towards the wall (direction
+//! `i`, wall velocity `u_w`)
+//!
+//! `F += (c_i - u_w) f*_i(x, t) - (c_k - u_w) f_k(x, t+1)`, with `k = opp(i)`,
+//!
+//! where `f_k(x, t+1)` is the population the wall sends back (the Bouzidi value, before the
+//! collision at `t+1`). Summed in link order, serially, so the result does not depend on the
+//! thread count.
+
+use super::boundary::bouzidi;
+use super::kernel::KernelCtx;
+use super::lattice::{CX, CY, OPP, Q, W};
+
+pub(crate) fn link_forces(c: &KernelCtx, src: &[f32], forces: &mut [[f64; 2]]) {
+    forces.iter_mut().for_each(|f| *f = [0.0, 0.0]);
+    let nx = c.nx;
+    for l in c.links {
+        let x = l.cell as usize % nx;
+        let y = l.cell as usize / nx;
+        let k = l.k as usize;
+        let i = OPP[k];
+        let out = src[(y * Q + i) * nx + x] as f64 + W[i] as f64;
+        let back = bouzidi(c, src, x, y, l) as f64 + W[k] as f64;
+        let (ci, ck) = ([CX[i] as f64, CY[i] as f64], [CX[k] as f64, CY[k] as f64]);
+        let uw = [l.uw[0] as f64, l.uw[1] as f64];
+        let f = &mut forces[l.body as usize];
+        f[0] += (ci[0] - uw[0]) * out - (ck[0] - uw[0]) * back;
+        f[1] += (ci[1] - uw[1]) * out - (ck[1] - uw[1]) * back;
+    }
+}

@@ -1,0 +1,29 @@
+//! Lattice Boltzmann method, D2Q9.
+//!
+//! The source is modular (lattice, collision, one file per boundary) and fused at run time: one
+//! pull-scheme stream-collide pass per step that, for every node, loads the nine populations from
+//! its neighbours, applies boundaries where a neighbour is a wall or outside the domain, computes
+//! the moments, collides and stores (A-B pattern, two arrays). Interior rows run a branch-free,
+//! vectorised loop; the few nodes next to walls and domain edges run the general per-node path
+//! after it and overwrite the row's values there.
+//!
+//! Both arrays hold *post-collision* populations: after a step, `f` holds `f*(x, t+1)`. Moments
+//! (density, momentum) are invariant under collision, so they can be read from either.
+
+pub mod boundary;
+pub mod collision;
+mod check;
+mod domain;
+mod error;
+mod forces;
+mod kernel;
+pub mod lattice;
+mod probes;
+mod solver;
+mod units;
+
+pub use collision::Collision;
+pub use domain::{Grid, Side, Sides};
+pub use error::LbmError;
+pub use solver::{D2q9, D2q9Config, WallPoint};
+pub use units::Units;

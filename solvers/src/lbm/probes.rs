@@ -1,0 +1,31 @@
+//! Point probes: density and velocity at any physical point by bilinear interpolation of the four
+//! surrounding nodes (solid nodes count as resting fluid at rho = 1, which is the wall value).
+
+use super::error::LbmError;
+use super::solver::D2q9;
+
+impl D2q9 {
+    /// `(rho, ux, uy)` in lattice units at physical point `p`.
+    pub fn probe(&self, p: [f64; 2]) -> Result<[f64; 3], LbmError> {
+        let g = self.config().grid;
+        let (nx, ny) = (self.nx(), self.ny());
+        let xi = (p[0] - g.origin[0]) / g.dx;
+        let eta = (p[1] - g.origin[1]) / g.dx;
+        if !(xi >= 0.0 && eta >= 0.0 && xi <= (nx - 1) as f64 && eta <= (ny - 1) as f64) {
+            let hi = g.position((nx - 1) as f64, (ny - 1) as f64);
+            return Err(LbmError::ProbeOutside { x: p[0], y: p[1], xmin: g.origin[0], xmax: hi[0], ymin: g.origin[1], ymax: hi[1] });
+        }
+        let x0 = (xi.floor() as usize).min(nx - 2);
+        let y0 = (eta.floor() as usize).min(ny - 2);
+        let (tx, ty) = (xi - x0 as f64, eta - y0 as f64);
+        let mut out = [0.0f64; 3];
+        for (dx, dy, w) in [(0, 0, (1.0 - tx) * (1.0 - ty)), (1, 0, tx * (1.0 - ty)), (0, 1, (1.0 - tx) * ty), (1, 1, tx * ty)] {
+            let (x, y) = (x0 + dx, y0 + dy);
+            let (rho, ux, uy) = if self.is_solid(x, y) { (1.0, 0.0, 0.0) } else { self.node(x, y) };
+            out[0] += w * rho as f64;
+            out[1] += w * ux as f64;
+            out[2] += w * uy as f64;
+        }
+        Ok(out)
+    }
+}
