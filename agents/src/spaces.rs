@@ -12,7 +12,10 @@ pub struct BoxSpace {
 impl BoxSpace {
     /// `[low, high]^n`.
     pub fn uniform(n: usize, low: f64, high: f64) -> Self {
-        BoxSpace { low: vec![low; n], high: vec![high; n] }
+        BoxSpace {
+            low: vec![low; n],
+            high: vec![high; n],
+        }
     }
 
     /// The action space of every hgym environment: `[-1, 1]^n`.
@@ -26,7 +29,10 @@ impl BoxSpace {
 
     /// Whether `x` has the right length and lies inside the box.
     pub fn contains(&self, x: &[f64]) -> bool {
-        x.len() == self.dim() && x.iter().zip(self.low.iter().zip(&self.high)).all(|(v, (l, h))| *v >= *l && *v <= *h)
+        x.len() == self.dim()
+            && x.iter()
+                .zip(self.low.iter().zip(&self.high))
+                .all(|(v, (l, h))| *v >= *l && *v <= *h)
     }
 
     /// `x` clipped into the box; returns how many components were clipped.

@@ -38,7 +38,12 @@ fn poiseuille_error(h: usize, collision: Collision) -> f64 {
     let nu = (tau - 0.5) / 3.0;
     let u_max = 0.01;
     let force = 8.0 * nu * u_max / (h * h) as f64;
-    let sides = Sides { west: Side::Periodic, east: Side::Periodic, south: Side::Wall, north: Side::Wall };
+    let sides = Sides {
+        west: Side::Periodic,
+        east: Side::Periodic,
+        south: Side::Wall,
+        north: Side::Wall,
+    };
     let mut cfg = D2q9Config::new(4, h, tau, sides);
     cfg.body_force = [force, 0.0];
     cfg.collision = collision;
@@ -88,7 +93,11 @@ fn taylor_green_viscosity(n: usize, tau: f64, collision: Collision) -> f64 {
     let mut s = D2q9::new(cfg, vec![]).unwrap();
     s.init_with(|x, y| {
         let p = -0.25 * u0 * u0 * ((2.0 * k * x).cos() + (2.0 * k * y).cos());
-        (1.0 + 3.0 * p, -u0 * (k * x).cos() * (k * y).sin(), u0 * (k * x).sin() * (k * y).cos())
+        (
+            1.0 + 3.0 * p,
+            -u0 * (k * x).cos() * (k * y).sin(),
+            u0 * (k * x).sin() * (k * y).cos(),
+        )
     });
     let nu = (tau - 0.5) / 3.0;
     let t_decay = 1.0 / (2.0 * nu * k * k);
@@ -127,7 +136,11 @@ fn taylor_green_recovers_the_viscosity() {
             let nu = (tau - 0.5) / 3.0;
             let fitted = taylor_green_viscosity(64, tau, collision);
             let rel = (fitted - nu).abs() / nu;
-            println!("taylor-green[{}] 64^2 tau {tau}: nu set {nu:.6}, fitted {fitted:.6}, error {:.3} %", collision.name(), 100.0 * rel);
+            println!(
+                "taylor-green[{}] 64^2 tau {tau}: nu set {nu:.6}, fitted {fitted:.6}, error {:.3} %",
+                collision.name(),
+                100.0 * rel
+            );
             assert!(rel < 0.01, "viscosity off by {:.3} %", 100.0 * rel);
         }
     }
@@ -141,8 +154,16 @@ fn couette_through_the_moving_wall_path() {
     let (nx, ny) = (4, 24);
     let y_wall = 20.3;
     let u_wall = 0.05;
-    let sides = Sides { west: Side::Periodic, east: Side::Periodic, south: Side::Wall, north: Side::Wall };
-    let plane: Arc<dyn Shape> = Arc::new(HalfPlane { point: [0.0, y_wall], normal: [0.0, -1.0] });
+    let sides = Sides {
+        west: Side::Periodic,
+        east: Side::Periodic,
+        south: Side::Wall,
+        north: Side::Wall,
+    };
+    let plane: Arc<dyn Shape> = Arc::new(HalfPlane {
+        point: [0.0, y_wall],
+        normal: [0.0, -1.0],
+    });
     let mut s = D2q9::new(D2q9Config::new(nx, ny, 0.8, sides), vec![plane]).unwrap();
     s.set_wall_velocity(0, |_| [u_wall, 0.0]);
     run_to_steady(&mut s, 500, 1e-10, 200_000);
@@ -165,12 +186,23 @@ fn couette_through_the_moving_wall_path() {
 #[test]
 fn mass_is_conserved_in_a_closed_box() {
     let n = 48;
-    let sides = Sides { west: Side::Wall, east: Side::Wall, south: Side::Wall, north: Side::Wall };
+    let sides = Sides {
+        west: Side::Wall,
+        east: Side::Wall,
+        south: Side::Wall,
+        north: Side::Wall,
+    };
     for collision in [Collision::Bgk, Collision::Regularized] {
         let mut cfg = D2q9Config::new(n, n, 0.55, sides.clone());
         cfg.collision = collision;
         let mut s = D2q9::new(cfg, vec![]).unwrap();
-        s.init_with(|x, y| (1.0 + 0.01 * (0.3 * x).sin(), 0.05 * (0.2 * y).sin(), 0.04 * (0.25 * x + 0.1 * y).cos()));
+        s.init_with(|x, y| {
+            (
+                1.0 + 0.01 * (0.3 * x).sin(),
+                0.05 * (0.2 * y).sin(),
+                0.04 * (0.25 * x + 0.1 * y).cos(),
+            )
+        });
         let m0 = s.total_mass();
         s.advance(5000).unwrap();
         let rel = (s.total_mass() - m0).abs() / m0;
@@ -187,12 +219,17 @@ fn no_lift_on_a_cylinder_in_symmetric_steady_flow() {
     let u = 0.05;
     let tau = 3.0 * u * d / 20.0 + 0.5;
     let sides = Sides {
-        west: Side::Velocity { profile: vec![[u as f32, 0.0]; ny] },
+        west: Side::Velocity {
+            profile: vec![[u as f32, 0.0]; ny],
+        },
         east: Side::Outlet,
         south: Side::FreeSlip,
         north: Side::FreeSlip,
     };
-    let cyl: Arc<dyn Shape> = Arc::new(Circle { center: [50.0, (ny as f64 - 1.0) / 2.0], radius: d / 2.0 });
+    let cyl: Arc<dyn Shape> = Arc::new(Circle {
+        center: [50.0, (ny as f64 - 1.0) / 2.0],
+        radius: d / 2.0,
+    });
     let mut s = D2q9::new(D2q9Config::new(nx, ny, tau, sides), vec![cyl]).unwrap();
     s.init_with(|_, _| (1.0, u, 0.0));
     s.advance(12_000).unwrap();

@@ -10,10 +10,21 @@ fn cylinder_case(collision: Collision) -> D2q9 {
     let (nx, ny) = (90, 41);
     let u = 0.06f32;
     let profile: Vec<[f32; 2]> = (0..ny).map(|y| [u * (1.0 + 0.1 * (y as f32 * 0.3).sin()), 0.0]).collect();
-    let sides = Sides { west: Side::Velocity { profile }, east: Side::Outlet, south: Side::FreeSlip, north: Side::Wall };
+    let sides = Sides {
+        west: Side::Velocity { profile },
+        east: Side::Outlet,
+        south: Side::FreeSlip,
+        north: Side::Wall,
+    };
     let bodies: Vec<Arc<dyn Shape>> = vec![
-        Arc::new(Circle { center: [20.3, 19.7], radius: 5.2 }),
-        Arc::new(Rectangle { center: [45.0, 10.0], size: [6.0, 4.5] }),
+        Arc::new(Circle {
+            center: [20.3, 19.7],
+            radius: 5.2,
+        }),
+        Arc::new(Rectangle {
+            center: [45.0, 10.0],
+            size: [6.0, 4.5],
+        }),
         Arc::new(Naca4::from_digits("0012", 20.0, [55.0, 28.0], 15.0).unwrap()),
     ];
     let mut cfg = D2q9Config::new(nx, ny, 0.56, sides);
@@ -34,7 +45,11 @@ fn fast_kernel_matches_the_slow_oracle_bitwise() {
             fast.step().unwrap();
             slow.step_reference().unwrap();
         }
-        assert_eq!(fast.populations(), slow.populations(), "{collision:?}: fast and reference kernels differ");
+        assert_eq!(
+            fast.populations(),
+            slow.populations(),
+            "{collision:?}: fast and reference kernels differ"
+        );
         assert_eq!(fast.body_forces(), slow.body_forces());
     }
 }
@@ -99,7 +114,12 @@ fn refuses_tau_too_close_to_one_half() {
 
 #[test]
 fn refuses_mismatched_periodic_sides() {
-    let sides = Sides { west: Side::Periodic, east: Side::Outlet, south: Side::Wall, north: Side::Wall };
+    let sides = Sides {
+        west: Side::Periodic,
+        east: Side::Outlet,
+        south: Side::Wall,
+        north: Side::Wall,
+    };
     let err = D2q9::new(D2q9Config::new(16, 16, 0.8, sides), vec![]).unwrap_err();
     assert!(matches!(err, LbmError::Config { field: "sides", .. }));
 }

@@ -72,13 +72,12 @@ mod tests {
                 self.0.bounding_box()
             }
         }
-        let c = Circle { center: [0.3, -0.2], radius: 0.5 };
+        let c = Circle {
+            center: [0.3, -0.2],
+            radius: 0.5,
+        };
         let plain = Plain(c.clone());
-        for (a, b) in [
-            ([0.9, -0.2], [0.7, -0.2]),
-            ([0.3, 0.4], [0.31, 0.25]),
-            ([-0.3, 0.2], [-0.1, 0.1]),
-        ] {
+        for (a, b) in [([0.9, -0.2], [0.7, -0.2]), ([0.3, 0.4], [0.31, 0.25]), ([-0.3, 0.2], [-0.1, 0.1])] {
             let exact = c.wall_fraction(a, b);
             let bis = plain.wall_fraction(a, b);
             assert!((exact - bis).abs() < 1e-12, "{exact} vs {bis}");

@@ -39,10 +39,7 @@ impl Naca4 {
             // Cosine spacing clusters points at the leading and trailing edges.
             let beta = std::f64::consts::PI * k as f64 / n as f64;
             let x = 0.5 * (1.0 - beta.cos());
-            let yt = 5.0
-                * t
-                * (0.2969 * x.sqrt() - 0.1260 * x - 0.3516 * x * x + 0.2843 * x.powi(3)
-                    - 0.1036 * x.powi(4));
+            let yt = 5.0 * t * (0.2969 * x.sqrt() - 0.1260 * x - 0.3516 * x * x + 0.2843 * x.powi(3) - 0.1036 * x.powi(4));
             let (yc, dyc) = if m == 0.0 || p == 0.0 {
                 (0.0, 0.0)
             } else if x < p {
@@ -60,7 +57,15 @@ impl Naca4 {
         // Counter-clockwise: trailing edge -> upper surface -> leading edge -> lower surface.
         let mut outline: Vec<[f64; 2]> = upper.into_iter().rev().collect();
         outline.extend(lower.into_iter().skip(1));
-        Self { m, p, t, chord, leading_edge, aoa_deg, outline }
+        Self {
+            m,
+            p,
+            t,
+            chord,
+            leading_edge,
+            aoa_deg,
+            outline,
+        }
     }
 
     /// Physical point -> body coordinates (undo translation and the nose-up rotation).
@@ -86,7 +91,11 @@ impl Shape for Naca4 {
             let e = [b[0] - a[0], b[1] - a[1]];
             let w = [p[0] - a[0], p[1] - a[1]];
             let ee = e[0] * e[0] + e[1] * e[1];
-            let t = if ee > 0.0 { ((w[0] * e[0] + w[1] * e[1]) / ee).clamp(0.0, 1.0) } else { 0.0 };
+            let t = if ee > 0.0 {
+                ((w[0] * e[0] + w[1] * e[1]) / ee).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             let r = [w[0] - t * e[0], w[1] - t * e[1]];
             d2 = d2.min(r[0] * r[0] + r[1] * r[1]);
             if (a[1] > p[1]) != (b[1] > p[1]) {

@@ -13,7 +13,12 @@ pub(crate) struct RowStat {
 }
 
 pub(crate) fn scan_row(f: &[f32], solid: &[bool], nx: usize, y: usize) -> RowStat {
-    let mut st = RowStat { nan_at: None, rho_min: (f32::INFINITY, 0), rho_max: (f32::NEG_INFINITY, 0), u2_max: (0.0, 0) };
+    let mut st = RowStat {
+        nan_at: None,
+        rho_min: (f32::INFINITY, 0),
+        rho_max: (f32::NEG_INFINITY, 0),
+        u2_max: (0.0, 0),
+    };
     for x in 0..nx {
         if solid[y * nx + x] {
             continue;

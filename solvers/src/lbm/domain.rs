@@ -55,7 +55,12 @@ pub struct Sides {
 impl Sides {
     /// Periodic in both directions.
     pub fn periodic() -> Self {
-        Sides { west: Side::Periodic, east: Side::Periodic, south: Side::Periodic, north: Side::Periodic }
+        Sides {
+            west: Side::Periodic,
+            east: Side::Periodic,
+            south: Side::Periodic,
+            north: Side::Periodic,
+        }
     }
 }
 
@@ -69,7 +74,10 @@ pub struct Grid {
 impl Grid {
     /// Lattice units: node `(i, j)` at `(i, j)`.
     pub fn lattice() -> Self {
-        Grid { origin: [0.0, 0.0], dx: 1.0 }
+        Grid {
+            origin: [0.0, 0.0],
+            dx: 1.0,
+        }
     }
 
     pub fn position(&self, x: f64, y: f64) -> [f64; 2] {

@@ -14,5 +14,12 @@ pub enum LbmError {
 
     /// A probe point outside the grid.
     #[error("probe point ({x:.4}, {y:.4}) lies outside the domain [{xmin:.4}, {xmax:.4}] x [{ymin:.4}, {ymax:.4}]")]
-    ProbeOutside { x: f64, y: f64, xmin: f64, xmax: f64, ymin: f64, ymax: f64 },
+    ProbeOutside {
+        x: f64,
+        y: f64,
+        xmin: f64,
+        xmax: f64,
+        ymin: f64,
+        ymax: f64,
+    },
 }

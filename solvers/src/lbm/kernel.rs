@@ -102,8 +102,17 @@ pub(crate) fn row_kernel<const REG: bool, const FORCED: bool>(c: &KernelCtx, src
         let n = nx - 2;
         let s: [&[f32]; Q] = std::array::from_fn(|i| c.shifted(src, y, i));
         let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = s;
-        let (s0, s1, s2, s3, s4, s5, s6, s7, s8) =
-            (&s0[..n], &s1[..n], &s2[..n], &s3[..n], &s4[..n], &s5[..n], &s6[..n], &s7[..n], &s8[..n]);
+        let (s0, s1, s2, s3, s4, s5, s6, s7, s8) = (
+            &s0[..n],
+            &s1[..n],
+            &s2[..n],
+            &s3[..n],
+            &s4[..n],
+            &s5[..n],
+            &s6[..n],
+            &s7[..n],
+            &s8[..n],
+        );
         let (d0, rest) = row.split_at_mut(nx);
         let (d1, rest) = rest.split_at_mut(nx);
         let (d2, rest) = rest.split_at_mut(nx);
@@ -147,7 +156,12 @@ pub(crate) fn row_kernel<const REG: bool, const FORCED: bool>(c: &KernelCtx, src
 pub(crate) fn row_reference<const REG: bool, const FORCED: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
     let specials = &c.specials[c.row_start[y] as usize..c.row_start[y + 1] as usize];
     for x in 0..c.nx {
-        let plain = Special { x: x as u32, solid: false, link_start: 0, link_end: 0 };
+        let plain = Special {
+            x: x as u32,
+            solid: false,
+            link_start: 0,
+            link_end: 0,
+        };
         let sp = specials.iter().find(|s| s.x as usize == x).unwrap_or(&plain);
         general_node::<REG, FORCED>(c, src, row, x, y, sp);
     }

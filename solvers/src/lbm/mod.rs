@@ -11,8 +11,8 @@
 //! (density, momentum) are invariant under collision, so they can be read from either.
 
 pub mod boundary;
-pub mod collision;
 mod check;
+pub mod collision;
 mod domain;
 mod error;
 mod forces;

@@ -13,13 +13,25 @@ impl D2q9 {
         let eta = (p[1] - g.origin[1]) / g.dx;
         if !(xi >= 0.0 && eta >= 0.0 && xi <= (nx - 1) as f64 && eta <= (ny - 1) as f64) {
             let hi = g.position((nx - 1) as f64, (ny - 1) as f64);
-            return Err(LbmError::ProbeOutside { x: p[0], y: p[1], xmin: g.origin[0], xmax: hi[0], ymin: g.origin[1], ymax: hi[1] });
+            return Err(LbmError::ProbeOutside {
+                x: p[0],
+                y: p[1],
+                xmin: g.origin[0],
+                xmax: hi[0],
+                ymin: g.origin[1],
+                ymax: hi[1],
+            });
         }
         let x0 = (xi.floor() as usize).min(nx - 2);
         let y0 = (eta.floor() as usize).min(ny - 2);
         let (tx, ty) = (xi - x0 as f64, eta - y0 as f64);
         let mut out = [0.0f64; 3];
-        for (dx, dy, w) in [(0, 0, (1.0 - tx) * (1.0 - ty)), (1, 0, tx * (1.0 - ty)), (0, 1, (1.0 - tx) * ty), (1, 1, tx * ty)] {
+        for (dx, dy, w) in [
+            (0, 0, (1.0 - tx) * (1.0 - ty)),
+            (1, 0, tx * (1.0 - ty)),
+            (0, 1, (1.0 - tx) * ty),
+            (1, 1, tx * ty),
+        ] {
             let (x, y) = (x0 + dx, y0 + dy);
             let (rho, ux, uy) = if self.is_solid(x, y) { (1.0, 0.0, 0.0) } else { self.node(x, y) };
             out[0] += w * rho as f64;

@@ -125,7 +125,10 @@ fn kernel_ctx<'a>(
 }
 
 fn config_error(field: &'static str, message: impl Into<String>) -> LbmError {
-    LbmError::Config { field, message: message.into() }
+    LbmError::Config {
+        field,
+        message: message.into(),
+    }
 }
 
 impl D2q9 {
@@ -134,9 +137,16 @@ impl D2q9 {
     pub fn new(cfg: D2q9Config, bodies: Vec<Arc<dyn Shape>>) -> Result<Self, LbmError> {
         let (nx, ny) = (cfg.nx, cfg.ny);
         if nx < 3 || ny < 3 {
-            return Err(config_error("size", format!("the grid must be at least 3 x 3 nodes, got {nx} x {ny}")));
+            return Err(config_error(
+                "size",
+                format!("the grid must be at least 3 x 3 nodes, got {nx} x {ny}"),
+            ));
         }
-        if nx.checked_mul(ny).and_then(|n| n.checked_mul(Q)).is_none_or(|n| n > u32::MAX as usize) {
+        if nx
+            .checked_mul(ny)
+            .and_then(|n| n.checked_mul(Q))
+            .is_none_or(|n| n > u32::MAX as usize)
+        {
             return Err(config_error("size", format!("{nx} x {ny} nodes is too large")));
         }
         let margin = cfg.tau - 0.5;
@@ -159,7 +169,12 @@ impl D2q9 {
         if (s.south == Side::Periodic) != (s.north == Side::Periodic) {
             return Err(config_error("sides", "south and north must both be periodic or neither"));
         }
-        for (name, side, len) in [("west", &s.west, ny), ("east", &s.east, ny), ("south", &s.south, nx), ("north", &s.north, nx)] {
+        for (name, side, len) in [
+            ("west", &s.west, ny),
+            ("east", &s.east, ny),
+            ("south", &s.south, nx),
+            ("north", &s.north, nx),
+        ] {
             if let Side::Velocity { profile } = side {
                 if profile.len() != len {
                     return Err(config_error(
@@ -219,7 +234,12 @@ impl D2q9 {
                 let cell = y * nx + x;
                 let edge = x == 0 || x + 1 == nx || !bulk_row(y);
                 if solid[cell] {
-                    specials.push(Special { x: x as u32, solid: true, link_start: 0, link_end: 0 });
+                    specials.push(Special {
+                        x: x as u32,
+                        solid: true,
+                        link_start: 0,
+                        link_end: 0,
+                    });
                     continue;
                 }
                 let link_start = links.len() as u32;
@@ -238,12 +258,27 @@ impl D2q9 {
                     let q = if body.sdf(bpt) <= 0.0 { body.wall_fraction(a, bpt) } else { 0.5 };
                     let q = q.clamp(1e-3, 1.0);
                     let wp = [a[0] + q * (bpt[0] - a[0]), a[1] + q * (bpt[1] - a[1])];
-                    links.push(Link { cell: cell as u32, k: k as u8, q: q as f32, uw: [0.0, 0.0], body: b as u16 });
-                    wall_points.push(WallPoint { position: wp, normal: body.normal(wp), body: b });
+                    links.push(Link {
+                        cell: cell as u32,
+                        k: k as u8,
+                        q: q as f32,
+                        uw: [0.0, 0.0],
+                        body: b as u16,
+                    });
+                    wall_points.push(WallPoint {
+                        position: wp,
+                        normal: body.normal(wp),
+                        body: b,
+                    });
                 }
                 let link_end = links.len() as u32;
                 if edge || link_end > link_start {
-                    specials.push(Special { x: x as u32, solid: false, link_start, link_end });
+                    specials.push(Special {
+                        x: x as u32,
+                        solid: false,
+                        link_start,
+                        link_end,
+                    });
                 }
             }
         }
@@ -295,7 +330,15 @@ impl D2q9 {
 
     /// Advances one time step. Allocates nothing.
     pub fn step(&mut self) -> Result<(), LbmError> {
-        let ctx = kernel_ctx(&self.cfg, self.omega, &self.solid, &self.specials, &self.row_start, &self.links, self.velocity_scale);
+        let ctx = kernel_ctx(
+            &self.cfg,
+            self.omega,
+            &self.solid,
+            &self.specials,
+            &self.row_start,
+            &self.links,
+            self.velocity_scale,
+        );
         let src = &self.f;
         let row_len = Q * self.cfg.nx;
         let forced = self.cfg.body_force != [0.0, 0.0];
@@ -313,7 +356,9 @@ impl D2q9 {
         for (b, force) in self.body_forces.iter().enumerate() {
             if !force[0].is_finite() || !force[1].is_finite() {
                 let l = self.links.iter().find(|l| l.body as usize == b);
-                let (x, y) = l.map(|l| (l.cell as usize % self.cfg.nx, l.cell as usize / self.cfg.nx)).unwrap_or((0, 0));
+                let (x, y) = l
+                    .map(|l| (l.cell as usize % self.cfg.nx, l.cell as usize / self.cfg.nx))
+                    .unwrap_or((0, 0));
                 return Err(LbmError::Diverged {
                     step: self.time,
                     reason: format!("the force on body {b} is not finite"),
@@ -339,11 +384,19 @@ impl D2q9 {
     /// Scans every node for NaN, density out of `rho_bounds` or speed above `u_max`.
     pub fn check(&mut self) -> Result<(), LbmError> {
         let (nx, f, solid) = (self.cfg.nx, &self.f, &self.solid);
-        self.row_stats.par_iter_mut().enumerate().for_each(|(y, st)| *st = scan_row(f, solid, nx, y));
+        self.row_stats
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(y, st)| *st = scan_row(f, solid, nx, y));
         let [rho_lo, rho_hi] = self.cfg.rho_bounds;
         let u2_max = self.cfg.u_max * self.cfg.u_max;
         for (y, st) in self.row_stats.iter().enumerate() {
-            let diverged = |reason: String, x: usize| LbmError::Diverged { step: self.time, reason, x, y };
+            let diverged = |reason: String, x: usize| LbmError::Diverged {
+                step: self.time,
+                reason,
+                x,
+                y,
+            };
             if let Some(x) = st.nan_at {
                 return Err(diverged("NaN in the populations".into(), x));
             }
@@ -355,7 +408,12 @@ impl D2q9 {
             }
             if st.u2_max.0 > u2_max {
                 return Err(diverged(
-                    format!("lattice speed {:.4} above {} (Mach {:.2})", st.u2_max.0.sqrt(), self.cfg.u_max, st.u2_max.0.sqrt() * 3f32.sqrt()),
+                    format!(
+                        "lattice speed {:.4} above {} (Mach {:.2})",
+                        st.u2_max.0.sqrt(),
+                        self.cfg.u_max,
+                        st.u2_max.0.sqrt() * 3f32.sqrt()
+                    ),
                     st.u2_max.1,
                 ));
             }
@@ -473,7 +531,10 @@ impl D2q9 {
     /// Overwrites the populations (e.g. from a checkpoint) and sets the step counter.
     pub fn set_populations(&mut self, f: &[f32], time: u64) -> Result<(), LbmError> {
         if f.len() != self.f.len() {
-            return Err(config_error("populations", format!("expected {} values, got {}", self.f.len(), f.len())));
+            return Err(config_error(
+                "populations",
+                format!("expected {} values, got {}", self.f.len(), f.len()),
+            ));
         }
         self.f.copy_from_slice(f);
         self.time = time;
@@ -484,7 +545,15 @@ impl D2q9 {
     /// (no bulk/special split, no vectorisation), single-threaded.
     #[doc(hidden)]
     pub fn step_reference(&mut self) -> Result<(), LbmError> {
-        let ctx = kernel_ctx(&self.cfg, self.omega, &self.solid, &self.specials, &self.row_start, &self.links, self.velocity_scale);
+        let ctx = kernel_ctx(
+            &self.cfg,
+            self.omega,
+            &self.solid,
+            &self.specials,
+            &self.row_start,
+            &self.links,
+            self.velocity_scale,
+        );
         let forced = self.cfg.body_force != [0.0, 0.0];
         let row_len = Q * self.cfg.nx;
         for (y, row) in self.f_next.chunks_mut(row_len).enumerate() {

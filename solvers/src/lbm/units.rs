@@ -79,7 +79,11 @@ mod tests {
 
     #[test]
     fn round_trips() {
-        let u = Units { cells_per_length: 20.0, u_lattice: 0.05, reynolds: 100.0 };
+        let u = Units {
+            cells_per_length: 20.0,
+            u_lattice: 0.05,
+            reynolds: 100.0,
+        };
         assert!((u.nu() - 0.01).abs() < 1e-15);
         assert!((u.tau() - 0.53).abs() < 1e-12);
         assert_eq!(u.steps(1.0), 400);

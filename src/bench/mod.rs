@@ -1,0 +1,14 @@
+//! Speed benchmarks, reported against the machine's limit measured in the same run.
+//!
+//! `hgym bench lbm`: million lattice updates per second (MLUPS) of the D2Q9 step at three sizes
+//! (L2-resident, L3-resident, far beyond the last-level cache), with 1 and 2 threads, next to a
+//! STREAM-style copy bandwidth with the same thread count. The roofline is
+//! `bandwidth / bytes per cell update`; the FP32 kernel moves 72 bytes per update (nine 4-byte
+//! populations read, nine written; no flag field), the same read+write convention STREAM's copy
+//! uses. Each size first passes a correctness check (Taylor-Green decay) before it is timed.
+
+mod lbm;
+mod stream;
+
+pub use lbm::{bench_lbm, BenchReport, BenchRow, LbmBenchOptions};
+pub use stream::stream_copy_gbs;

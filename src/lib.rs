@@ -1,0 +1,13 @@
+//! # hgym: reinforcement-learning flow control
+//!
+//! This crate ties the numerics ([`hgym_solvers`]) to learning ([`hgym_agents`]): validation
+//! against the literature ([`validate`]), plots and reports ([`report`]), speed benchmarks
+//! ([`bench`]). The binary `hgym` is a thin command line over these modules.
+//!
+//! Units: environments and validation cases speak the paper's non-dimensional units (reference
+//! length D = 1, free-stream velocity U = 1, time in D/U); lattice units stay inside the solvers
+//! and are converted by [`hgym_solvers::lbm::Units`].
+
+pub mod bench;
+pub mod report;
+pub mod validate;

@@ -1,0 +1,232 @@
+//! `hgym`: the command line. Parses, calls the library, prints text or `--json`, and maps the
+//! outcome to an exit code: 0 ok, 1 a check failed (validation out of tolerance, solver
+//! diverged, benchmark short of its target), 2 bad usage or bad input.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use hgym::bench::{bench_lbm, LbmBenchOptions};
+use hgym::validate::{self, Level, LoadedCase, Options, Status, ValidateError};
+
+#[derive(Parser)]
+#[command(
+    name = "hgym",
+    version,
+    about = "Reinforcement-learning flow control: validated CFD environments, benchmarks and reports",
+    long_about = "hgym runs flow-control environments on fast in-process solvers.\n\n\
+                  Start with `hgym validate cylinder` (checks the lattice-Boltzmann solver against the \
+                  literature: Strouhal number, mean drag and lift amplitude at Re 100 and 200) and \
+                  `hgym bench lbm` (solver speed against the machine's memory bandwidth)."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run validation cases against published numbers and write JSON reports and plots.
+    ///
+    /// `hgym validate cylinder` runs the bundled cylinder cases; `hgym validate --case FILE`
+    /// runs any case file (see benchmarks/validation/*.toml for the format). Exit code 0 when
+    /// every quantity is within its tolerance, 1 when one is not or the solver diverged, 2 for
+    /// bad input (unknown family, malformed file, parameters that cannot run).
+    Validate(ValidateArgs),
+    /// Measure solver speed against the machine's limits.
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+#[derive(Args)]
+struct ValidateArgs {
+    /// Family of bundled cases to run (e.g. `cylinder`); omit it with --case or --list.
+    family: Option<String>,
+    /// Case file(s) to run instead of a bundled family (repeatable).
+    #[arg(long = "case", value_name = "FILE")]
+    cases: Vec<PathBuf>,
+    /// Resolution level (cells per reference length as given in each case file).
+    #[arg(long, value_enum, default_value_t = Level::Default)]
+    level: Level,
+    /// Output folder for `<case>.json` and `<case>/*.png`.
+    #[arg(long, default_value = "results/validation")]
+    out: PathBuf,
+    /// Worker threads (default: all cores). Results are bitwise identical for any count.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Print the reports as a JSON array on stdout instead of tables.
+    #[arg(long)]
+    json: bool,
+    /// List the bundled cases and exit.
+    #[arg(long)]
+    list: bool,
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// D2Q9 lattice-Boltzmann step: MLUPS at three sizes, 1 and 2 threads, against a STREAM copy
+    /// measured in the same run. Exit 1 if the memory-bound size reaches less than 70 % of the
+    /// roofline.
+    Lbm {
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+        /// A fast smoke run (small sizes, short timings; the target is not judged).
+        #[arg(long)]
+        quick: bool,
+        /// Collision operator to time.
+        #[arg(long, value_enum, default_value = "regularized")]
+        collision: CollisionArg,
+    },
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum CollisionArg {
+    Bgk,
+    Regularized,
+}
+
+/// Outcome of a command: 0 ok, 1 a check failed.
+enum Outcome {
+    Ok,
+    CheckFailed,
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    let result = match cli.command {
+        Command::Validate(args) => run_validate(args),
+        Command::Bench(BenchCommand::Lbm { json, quick, collision }) => run_bench(json, quick, collision),
+    };
+    match result {
+        Ok(Outcome::Ok) => ExitCode::SUCCESS,
+        Ok(Outcome::CheckFailed) => ExitCode::from(1),
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            let bad_input = e
+                .chain()
+                .any(|c| c.downcast_ref::<ValidateError>().is_some_and(|v| v.is_bad_input()) || c.downcast_ref::<UsageError>().is_some());
+            ExitCode::from(if bad_input { 2 } else { 1 })
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+struct UsageError(String);
+
+fn thread_pool(threads: Option<usize>) -> Result<(rayon::ThreadPool, usize)> {
+    let n = threads.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
+    if n == 0 {
+        return Err(UsageError("--threads must be at least 1".into()).into());
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build()
+        .context("cannot start the worker threads")?;
+    Ok((pool, n))
+}
+
+fn progress_bar(total: u64, label: &str) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::new(total);
+    let style = ProgressStyle::with_template("{msg:>16} [{bar:40.cyan/blue}] {pos}/{len} steps, {per_sec}, eta {eta}")
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> ");
+    pb.set_style(style);
+    pb.set_message(label.to_string());
+    pb
+}
+
+fn run_validate(args: ValidateArgs) -> Result<Outcome> {
+    if args.list {
+        for c in validate::bundled()? {
+            println!("{:<10} {:<18} {}", c.case.case.family, c.case.case.name, c.case.case.description);
+        }
+        return Ok(Outcome::Ok);
+    }
+    let cases: Vec<LoadedCase> = match (&args.family, args.cases.is_empty()) {
+        (Some(_), false) => return Err(UsageError("give either a family or --case FILE, not both".into()).into()),
+        (None, true) => {
+            let known = validate::families()?.join(", ");
+            return Err(UsageError(format!(
+                "nothing to validate: name a family ({known}) or give --case FILE; --list shows the bundled cases"
+            ))
+            .into());
+        }
+        (Some(f), true) => validate::family_cases(f)?,
+        (None, false) => args.cases.iter().map(|p| validate::load_file(p)).collect::<Result<_, _>>()?,
+    };
+    // Refuse unrunnable parameters for every case before running any.
+    for c in &cases {
+        validate::plan(c, args.level)?;
+    }
+    let (pool, threads) = thread_pool(args.threads)?;
+    let opts = Options {
+        level: args.level,
+        out: args.out.clone(),
+        threads,
+    };
+    let mut reports = Vec::new();
+    for c in &cases {
+        let plan = validate::plan(c, args.level)?;
+        let pb = progress_bar(plan.total_steps, &c.case.case.name);
+        let report = pool
+            .install(|| validate::validate_case(c, &opts, &mut |done, _| pb.set_position(done)))
+            .with_context(|| format!("validation case '{}'", c.case.case.name))?;
+        pb.finish_and_clear();
+        if !args.json {
+            print!("{}", report.table());
+            println!("  report: {}", args.out.join(format!("{}.json", report.case)).display());
+            println!();
+        }
+        reports.push(report);
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&reports)?);
+    }
+    let all_pass = reports.iter().all(|r| r.status == Status::Pass);
+    Ok(if all_pass { Outcome::Ok } else { Outcome::CheckFailed })
+}
+
+fn run_bench(json: bool, quick: bool, collision: CollisionArg) -> Result<Outcome> {
+    let mut opts = LbmBenchOptions {
+        collision: match collision {
+            CollisionArg::Bgk => hgym_solvers::lbm::Collision::Bgk,
+            CollisionArg::Regularized => hgym_solvers::lbm::Collision::Regularized,
+        },
+        ..LbmBenchOptions::default()
+    };
+    if quick {
+        opts.sizes = vec![(32, 32), (128, 64), (256, 256)];
+        opts.seconds = 0.05;
+        opts.stream_values = 1 << 22;
+    }
+    let quiet = json;
+    let report = bench_lbm(&opts, &mut |msg| {
+        if !quiet {
+            eprintln!("{msg}");
+        }
+    })
+    .map_err(anyhow::Error::msg)
+    .context("LBM benchmark")?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", report.table());
+    }
+    Ok(if report.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
+}

@@ -1,0 +1,226 @@
+//! Statistics of force histories: Strouhal number from the lift signal, means and amplitudes over
+//! whole shedding periods.
+//!
+//! Periods come from upward zero crossings of the fluctuating lift `C_L - mean(C_L)` (linear
+//! interpolation between samples, with a hysteresis of a tenth of the standard deviation so noise
+//! does not count as a crossing): `St = f L / U = 1 / T` in units of L/U. Means and amplitudes are
+//! taken between the first and the last crossing, i.e. over whole periods. The lift spectrum
+//! (Hann window, zero-padded FFT, peak refined by a parabola through the log-magnitudes) gives a
+//! second, independent frequency estimate.
+
+use realfft::RealFftPlanner;
+use serde::Serialize;
+
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct Analysis {
+    /// From zero crossings; `None` if fewer than two whole periods (steady flow).
+    pub strouhal: Option<f64>,
+    /// From the spectral peak.
+    pub strouhal_spectral: Option<f64>,
+    pub mean_cd: f64,
+    pub mean_cl: f64,
+    pub cl_amplitude: f64,
+    pub cl_rms: f64,
+    pub cd_amplitude: f64,
+    /// Whole periods used.
+    pub periods: usize,
+    /// Time window the means are taken over `[t0, t1]`.
+    pub window: [f64; 2],
+}
+
+/// The lift spectrum over the window: `(frequencies, amplitudes)`.
+pub fn spectrum(t: &[f64], signal: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let n = signal.len();
+    if n < 8 {
+        return (vec![], vec![]);
+    }
+    let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
+    let mean = signal.iter().sum::<f64>() / n as f64;
+    let padded = (4 * n).next_power_of_two();
+    let mut input = vec![0.0f64; padded];
+    for (j, v) in signal.iter().enumerate() {
+        let w = 0.5 * (1.0 - (2.0 * std::f64::consts::PI * j as f64 / (n - 1) as f64).cos());
+        input[j] = (v - mean) * w;
+    }
+    let mut planner = RealFftPlanner::<f64>::new();
+    let fft = planner.plan_fft_forward(padded);
+    let mut out = fft.make_output_vec();
+    // Lengths match the plan by construction.
+    if fft.process(&mut input, &mut out).is_err() {
+        return (vec![], vec![]);
+    }
+    let freqs = (0..out.len()).map(|k| k as f64 / (padded as f64 * dt)).collect();
+    // Hann window has coherent gain 1/2.
+    let amps = out.iter().map(|c| 4.0 * c.norm() / n as f64).collect();
+    (freqs, amps)
+}
+
+fn spectral_peak(freqs: &[f64], amps: &[f64]) -> Option<f64> {
+    if amps.len() < 3 {
+        return None;
+    }
+    let k = (1..amps.len() - 1).max_by(|&a, &b| amps[a].total_cmp(&amps[b]))?;
+    let (a, b, c) = (amps[k - 1].max(1e-300).ln(), amps[k].max(1e-300).ln(), amps[k + 1].max(1e-300).ln());
+    let den = a - 2.0 * b + c;
+    let shift = if den.abs() > 0.0 { 0.5 * (a - c) / den } else { 0.0 };
+    let df = freqs[1] - freqs[0];
+    Some(freqs[k] + shift.clamp(-0.5, 0.5) * df)
+}
+
+/// Centred moving average over `2 half + 1` samples (shorter at the ends).
+fn moving_average(v: &[f64], half: usize) -> Vec<f64> {
+    if half == 0 {
+        return v.to_vec();
+    }
+    let n = v.len();
+    let mut prefix = vec![0.0f64; n + 1];
+    for (j, x) in v.iter().enumerate() {
+        prefix[j + 1] = prefix[j] + x;
+    }
+    (0..n)
+        .map(|j| {
+            let lo = j.saturating_sub(half);
+            let hi = (j + half + 1).min(n);
+            (prefix[hi] - prefix[lo]) / (hi - lo) as f64
+        })
+        .collect()
+}
+
+/// Analyses the samples with `t >= t_start`.
+pub fn analyse(t: &[f64], cd: &[f64], cl: &[f64], t_start: f64) -> Analysis {
+    let first = t.iter().position(|&v| v >= t_start).unwrap_or(t.len());
+    let (t, cd, cl) = (&t[first..], &cd[first..], &cl[first..]);
+    let n = t.len();
+    if n < 2 {
+        return Analysis::default();
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let m_cl = mean(cl);
+    let std = (cl.iter().map(|v| (v - m_cl).powi(2)).sum::<f64>() / n as f64).sqrt();
+    let hyst = 0.1 * std;
+    let (freqs, amps) = spectrum(t, cl);
+    let strouhal_spectral = if std > 1e-9 { spectral_peak(&freqs, &amps) } else { None };
+    // Crossings are found on the lift smoothed over a tenth of the spectral period (a centred
+    // moving average), so that high-frequency noise cannot add spurious crossings; means and
+    // amplitudes use the raw signal.
+    let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
+    let half = strouhal_spectral.map_or(0, |f| ((0.05 / (f * dt)).round() as usize).min(n / 4));
+    let smooth = moving_average(cl, half);
+    // Upward crossings (time, sample index after the crossing).
+    let mut crossings: Vec<(f64, usize)> = Vec::new();
+    let mut armed = false;
+    for j in 1..n {
+        let (a, b) = (smooth[j - 1] - m_cl, smooth[j] - m_cl);
+        if a < -hyst {
+            armed = true;
+        }
+        if armed && a < 0.0 && b >= 0.0 {
+            let tc = t[j - 1] + (t[j] - t[j - 1]) * (-a) / (b - a);
+            crossings.push((tc, j));
+            armed = false;
+        }
+    }
+    if crossings.len() >= 3 && std > 1e-9 {
+        let periods = crossings.len() - 1;
+        let (t0, j0) = crossings[0];
+        let (t1, j1) = crossings[periods];
+        let period = (t1 - t0) / periods as f64;
+        let cd_w = &cd[j0..j1];
+        let cl_w = &cl[j0..j1];
+        let m_cl_w = mean(cl_w);
+        let mut amp_l = 0.0;
+        let mut amp_d = 0.0;
+        for p in 0..periods {
+            let (a, b) = (crossings[p].1, crossings[p + 1].1);
+            let (lo, hi) = cl[a..b]
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+            amp_l += 0.5 * (hi - lo);
+            let (lo, hi) = cd[a..b]
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+            amp_d += 0.5 * (hi - lo);
+        }
+        Analysis {
+            strouhal: Some(1.0 / period),
+            strouhal_spectral,
+            mean_cd: mean(cd_w),
+            mean_cl: m_cl_w,
+            cl_amplitude: amp_l / periods as f64,
+            cl_rms: (cl_w.iter().map(|v| (v - m_cl_w).powi(2)).sum::<f64>() / cl_w.len() as f64).sqrt(),
+            cd_amplitude: amp_d / periods as f64,
+            periods,
+            window: [t0, t1],
+        }
+    } else {
+        let (lo, hi) = cl
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        let (dlo, dhi) = cd
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        Analysis {
+            strouhal: None,
+            strouhal_spectral: None,
+            mean_cd: mean(cd),
+            mean_cl: m_cl,
+            cl_amplitude: 0.5 * (hi - lo),
+            cl_rms: std,
+            cd_amplitude: 0.5 * (dhi - dlo),
+            periods: 0,
+            window: [t[0], t[n - 1]],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn recovers_frequency_mean_and_amplitude_of_a_synthetic_signal() {
+        let dt = 0.01;
+        let st = 0.1957;
+        let t: Vec<f64> = (0..20_000).map(|j| j as f64 * dt).collect();
+        let cl: Vec<f64> = t
+            .iter()
+            .map(|t| 0.05 + 0.66 * (2.0 * std::f64::consts::PI * st * t + 0.3).sin())
+            .collect();
+        let cd: Vec<f64> = t
+            .iter()
+            .map(|t| 1.35 + 0.02 * (4.0 * std::f64::consts::PI * st * t).sin())
+            .collect();
+        let a = analyse(&t, &cd, &cl, 20.0);
+        assert!((a.strouhal.unwrap() - st).abs() < 1e-4, "{:?}", a.strouhal);
+        assert!((a.strouhal_spectral.unwrap() - st).abs() < 2e-3, "{:?}", a.strouhal_spectral);
+        assert!((a.mean_cd - 1.35).abs() < 1e-3);
+        assert!((a.mean_cl - 0.05).abs() < 1e-3);
+        assert!((a.cl_amplitude - 0.66).abs() < 1e-3);
+        assert!((a.cl_rms - 0.66 / 2f64.sqrt()).abs() < 2e-3);
+        assert!(a.periods >= 30);
+    }
+
+    #[test]
+    fn high_frequency_noise_does_not_add_crossings() {
+        let dt = 0.002;
+        let st = 0.17;
+        let t: Vec<f64> = (0..50_000).map(|j| j as f64 * dt).collect();
+        let cl: Vec<f64> = t
+            .iter()
+            .map(|t| 0.33 * (2.0 * std::f64::consts::PI * st * t).sin() + 0.1 * (2.0 * std::f64::consts::PI * 2.3 * t).sin())
+            .collect();
+        let cd = vec![1.3; t.len()];
+        let a = analyse(&t, &cd, &cl, 10.0);
+        assert!((a.strouhal.unwrap() - st).abs() < 1e-3, "{:?}", a.strouhal);
+    }
+
+    #[test]
+    fn steady_signal_has_no_strouhal_number() {
+        let t: Vec<f64> = (0..1000).map(|j| j as f64 * 0.01).collect();
+        let cd = vec![2.0; 1000];
+        let cl = vec![0.0; 1000];
+        let a = analyse(&t, &cd, &cl, 1.0);
+        assert_eq!(a.strouhal, None);
+        assert!((a.mean_cd - 2.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,315 @@
+//! The validation report: what was measured against what, and whether it passed. Serialised to
+//! JSON (shape: `schemas/validation.schema.json`) and printed as a table.
+
+use std::path::Path;
+
+use plotters::style::RGBColor;
+use serde::{Deserialize, Serialize};
+
+use super::analysis::{analyse, spectrum, Analysis};
+use super::case::{LoadedCase, Quantity};
+use super::run::{RunOutput, RunStatus};
+use crate::report::manifest::{manifest, Manifest};
+use crate::report::plots;
+
+pub const SCHEMA_ID: &str = "hgym/validation/v1";
+
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    Pass,
+    Fail,
+    Diverged,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Parameters {
+    pub reynolds: f64,
+    pub cells_per_length: f64,
+    pub lattice_velocity: f64,
+    pub tau: f64,
+    pub mach: f64,
+    pub nx: usize,
+    pub ny: usize,
+    pub collision: String,
+    pub spin_up: f64,
+    pub average: f64,
+    pub steps_planned: u64,
+    pub steps_run: u64,
+    pub mlups: f64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct QuantityResult {
+    pub name: String,
+    /// `None` when it could not be measured (e.g. no shedding, or the run diverged).
+    pub measured: Option<f64>,
+    pub reference: Option<f64>,
+    pub tolerance: Option<f64>,
+    /// "relative" or "absolute".
+    pub tolerance_kind: Option<String>,
+    /// Relative `(measured - reference) / |reference|` or absolute `measured - reference`.
+    pub deviation: Option<f64>,
+    /// `None` for quantities measured without a reference.
+    pub pass: Option<bool>,
+    pub source: Option<String>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct AnalysisOut {
+    pub strouhal_zero_crossings: Option<f64>,
+    pub strouhal_spectral: Option<f64>,
+    pub periods: usize,
+    pub window: [f64; 2],
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ValidationReport {
+    pub schema: String,
+    pub case: String,
+    pub family: String,
+    pub description: String,
+    pub origin: String,
+    pub case_hash: String,
+    pub level: String,
+    pub status: Status,
+    pub message: Option<String>,
+    pub parameters: Parameters,
+    pub quantities: Vec<QuantityResult>,
+    pub analysis: AnalysisOut,
+    /// Plot files, relative to the report's folder.
+    pub plots: Vec<String>,
+    pub manifest: Manifest,
+}
+
+fn measured(a: &Analysis, q: Quantity) -> Option<f64> {
+    match q {
+        Quantity::Strouhal => a.strouhal,
+        Quantity::MeanCd => Some(a.mean_cd),
+        Quantity::MeanCl => Some(a.mean_cl),
+        Quantity::ClAmplitude => Some(a.cl_amplitude),
+        Quantity::ClRms => Some(a.cl_rms),
+        Quantity::CdAmplitude => Some(a.cd_amplitude),
+    }
+    .filter(|v| v.is_finite())
+}
+
+impl ValidationReport {
+    pub fn from_run(c: &LoadedCase, out: &RunOutput, threads: usize) -> Self {
+        let case = &c.case;
+        let diverged = matches!(out.status, RunStatus::Diverged { .. });
+        let a = analyse(&out.t, &out.cd, &out.cl, case.time.spin_up);
+        let mut quantities = Vec::new();
+        for &q in &case.measure.quantities {
+            let m = if diverged { None } else { measured(&a, q) };
+            let r = case.reference.iter().find(|r| r.quantity == q);
+            let (reference, tolerance, kind, deviation, pass, source) = match r {
+                None => (None, None, None, None, None, None),
+                Some(r) => {
+                    let (tol, kind) = match (r.tolerance, r.abs_tolerance) {
+                        (Some(t), _) => (t, "relative"),
+                        (None, Some(t)) => (t, "absolute"),
+                        (None, None) => (0.0, "relative"),
+                    };
+                    let dev = m.map(|m| {
+                        if kind == "relative" {
+                            (m - r.value) / r.value.abs()
+                        } else {
+                            m - r.value
+                        }
+                    });
+                    let pass = dev.is_some_and(|d| d.abs() <= tol);
+                    (
+                        Some(r.value),
+                        Some(tol),
+                        Some(kind.to_string()),
+                        dev,
+                        Some(pass),
+                        Some(r.source.clone()),
+                    )
+                }
+            };
+            quantities.push(QuantityResult {
+                name: q.name().into(),
+                measured: m,
+                reference,
+                tolerance,
+                tolerance_kind: kind,
+                deviation,
+                pass,
+                source,
+            });
+        }
+        let (status, message) = match &out.status {
+            RunStatus::Diverged { message, .. } => (Status::Diverged, Some(message.clone())),
+            RunStatus::Completed => {
+                if quantities.iter().all(|q| q.pass != Some(false)) {
+                    (Status::Pass, None)
+                } else {
+                    let failed: Vec<String> = quantities
+                        .iter()
+                        .filter(|q| q.pass == Some(false))
+                        .map(|q| q.name.clone())
+                        .collect();
+                    (Status::Fail, Some(format!("out of tolerance: {}", failed.join(", "))))
+                }
+            }
+        };
+        let p = &out.plan;
+        ValidationReport {
+            schema: SCHEMA_ID.into(),
+            case: case.case.name.clone(),
+            family: case.case.family.clone(),
+            description: case.case.description.clone(),
+            origin: c.origin.clone(),
+            case_hash: c.hash.clone(),
+            level: p.level.name().into(),
+            status,
+            message,
+            parameters: Parameters {
+                reynolds: case.flow.reynolds,
+                cells_per_length: p.units.cells_per_length,
+                lattice_velocity: p.units.u_lattice,
+                tau: p.tau,
+                mach: p.mach,
+                nx: p.nx,
+                ny: p.ny,
+                collision: p.collision.name().into(),
+                spin_up: case.time.spin_up,
+                average: case.time.average,
+                steps_planned: p.total_steps,
+                steps_run: out.steps,
+                mlups: out.mlups,
+            },
+            quantities,
+            analysis: AnalysisOut {
+                strouhal_zero_crossings: a.strouhal,
+                strouhal_spectral: a.strouhal_spectral,
+                periods: a.periods,
+                window: a.window,
+            },
+            plots: vec!["forces.png".into(), "spectrum.png".into(), "vorticity.png".into()],
+            manifest: manifest(threads, out.wall_time_s),
+        }
+    }
+
+    /// Plain-text table: quantity, measured, reference, deviation, pass/fail.
+    pub fn table(&self) -> String {
+        let mut s = format!(
+            "{} [{}] level {} ({} x {} cells, {} cells/L, tau {:.5}, Ma {:.3}): {}\n",
+            self.case,
+            self.family,
+            self.level,
+            self.parameters.nx,
+            self.parameters.ny,
+            self.parameters.cells_per_length,
+            self.parameters.tau,
+            self.parameters.mach,
+            match self.status {
+                Status::Pass => "PASS",
+                Status::Fail => "FAIL",
+                Status::Diverged => "DIVERGED",
+            }
+        );
+        s += &format!(
+            "  {:<14} {:>10} {:>10} {:>10} {:>10}  {}\n",
+            "quantity", "measured", "reference", "deviation", "tolerance", "result"
+        );
+        for q in &self.quantities {
+            let num = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
+            let (dev, tol) = match q.tolerance_kind.as_deref() {
+                Some("absolute") => (
+                    q.deviation.map_or("-".into(), |d| format!("{d:+.4}")),
+                    q.tolerance.map_or("-".into(), |t| format!("{t:.4}")),
+                ),
+                _ => (
+                    q.deviation.map_or("-".into(), |d| format!("{:+.2}%", 100.0 * d)),
+                    q.tolerance.map_or("-".into(), |t| format!("{:.1}%", 100.0 * t)),
+                ),
+            };
+            let res = match q.pass {
+                Some(true) => "pass",
+                Some(false) => "FAIL",
+                None => "(info)",
+            };
+            s += &format!(
+                "  {:<14} {:>10} {:>10} {:>10} {:>10}  {}\n",
+                q.name,
+                num(q.measured),
+                num(q.reference),
+                dev,
+                tol,
+                res
+            );
+        }
+        if let Some(m) = &self.message {
+            s += &format!("  note: {m}\n");
+        }
+        s += &format!(
+            "  {} of {} steps in {:.1} s ({:.0} MLUPS), {} whole periods averaged over t = [{:.1}, {:.1}]\n",
+            self.parameters.steps_run,
+            self.parameters.steps_planned,
+            self.manifest.wall_time_s,
+            self.parameters.mlups,
+            self.analysis.periods,
+            self.analysis.window[0],
+            self.analysis.window[1]
+        );
+        s
+    }
+}
+
+/// Force history (window marked), lift spectrum (measured and reference St marked), vorticity.
+pub fn write_plots(r: &ValidationReport, out: &RunOutput, dir: &Path) -> Result<(), String> {
+    let title = format!("{} ({} level): drag and lift", r.case, r.level);
+    let window = (r.analysis.window[1] > r.analysis.window[0]).then_some(r.analysis.window);
+    plots::time_series(
+        &dir.join("forces.png"),
+        &title,
+        &out.t,
+        &[
+            plots::Series {
+                label: "C_D",
+                values: &out.cd,
+            },
+            plots::Series {
+                label: "C_L",
+                values: &out.cl,
+            },
+        ],
+        window,
+    )?;
+    let first = out.t.iter().position(|&t| t >= r.parameters.spin_up).unwrap_or(out.t.len());
+    let (freqs, amps) = spectrum(&out.t[first..], &out.cl[first..]);
+    let mut marks = Vec::new();
+    if let Some(st) = r.analysis.strouhal_zero_crossings {
+        marks.push((st, format!("measured St = {st:.4}"), RGBColor(200, 30, 30)));
+    }
+    if let Some(q) = r.quantities.iter().find(|q| q.name == "strouhal") {
+        if let Some(v) = q.reference {
+            marks.push((v, format!("reference St = {v:.4}"), RGBColor(30, 150, 30)));
+        }
+    }
+    let f_max = marks.iter().map(|m| m.0).fold(0.5f64, f64::max) * 2.0;
+    plots::spectrum(
+        &dir.join("spectrum.png"),
+        &format!("{}: lift spectrum after spin-up", r.case),
+        &freqs,
+        &amps,
+        f_max.min(2.0),
+        &marks,
+    )?;
+    let v = &out.vorticity;
+    let vmax = plots::abs_quantile(&v.values, 0.98);
+    let t_end = out.t.last().copied().unwrap_or(0.0);
+    plots::field(
+        &dir.join("vorticity.png"),
+        &format!("{}: vorticity w L/U at t = {t_end:.1} (colour range +-{vmax:.2})", r.case),
+        v.nx,
+        v.ny,
+        v.extent,
+        &v.values,
+        vmax,
+    )?;
+    Ok(())
+}

@@ -1,0 +1,284 @@
+//! Command-line behaviour: exit codes, messages that name the problem and the fix, reports that
+//! match their schema, and a case file the code has never seen.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn hgym(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hgym")).args(args).output().expect("run hgym")
+}
+
+fn text(o: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn write_case(dir: &Path, name: &str, body: &str) -> PathBuf {
+    let p = dir.join(format!("{name}.toml"));
+    std::fs::write(&p, body).unwrap();
+    p
+}
+
+/// A small, fast cylinder case; `edit` changes lines of it.
+fn small_case(edit: &[(&str, &str)]) -> String {
+    let mut s = std::fs::read_to_string(repo().join("benchmarks/validation/cylinder_re100.toml")).unwrap();
+    for (from, to) in edit {
+        assert!(s.contains(from), "template has no '{from}'");
+        s = s.replace(from, to);
+    }
+    s
+}
+
+fn schema_check(json: &serde_json::Value) {
+    let schema: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(repo().join("schemas/validation.schema.json")).unwrap()).unwrap();
+    let validator = jsonschema::validator_for(&schema).expect("schema compiles");
+    let errors: Vec<String> = validator
+        .iter_errors(json)
+        .map(|e| format!("{e} at {}", e.instance_path()))
+        .collect();
+    assert!(
+        errors.is_empty(),
+        "report does not match schemas/validation.schema.json: {errors:?}"
+    );
+}
+
+#[test]
+fn help_explains_the_commands() {
+    let o = hgym(&["--help"]);
+    assert!(o.status.success());
+    let (out, _) = text(&o);
+    assert!(out.contains("validate") && out.contains("bench"));
+    let o = hgym(&["validate", "--help"]);
+    assert!(o.status.success());
+    assert!(text(&o).0.contains("--case"));
+}
+
+#[test]
+fn no_arguments_is_a_usage_error() {
+    assert_eq!(hgym(&[]).status.code(), Some(2));
+    let o = hgym(&["validate"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("cylinder"), "should list the families: {}", text(&o).1);
+}
+
+#[test]
+fn list_shows_the_bundled_cases() {
+    let o = hgym(&["validate", "--list"]);
+    assert!(o.status.success());
+    let (out, _) = text(&o);
+    assert!(out.contains("cylinder_re100") && out.contains("cylinder_re200"));
+}
+
+#[test]
+fn unknown_family_exits_2_with_the_list() {
+    let o = hgym(&["validate", "cylindre"]);
+    assert_eq!(o.status.code(), Some(2));
+    let (_, err) = text(&o);
+    assert!(
+        err.contains("unknown validation family 'cylindre'") && err.contains("cylinder"),
+        "{err}"
+    );
+}
+
+#[test]
+fn missing_case_file_exits_2() {
+    let o = hgym(&["validate", "--case", "/nonexistent/case.toml"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("/nonexistent/case.toml"));
+}
+
+#[test]
+fn malformed_toml_exits_2_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write_case(dir.path(), "broken", "[case\nname = 1");
+    let o = hgym(&["validate", "--case", p.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let (_, err) = text(&o);
+    assert!(err.contains("malformed case file") && err.contains("broken.toml"), "{err}");
+}
+
+#[test]
+fn unknown_key_exits_2_naming_the_key_and_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write_case(
+        dir.path(),
+        "typo",
+        &small_case(&[("reynolds = 100.0", "reynolds = 100.0\nviscosity = 0.01")]),
+    );
+    let o = hgym(&["validate", "--case", p.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let (_, err) = text(&o);
+    assert!(err.contains("viscosity") && err.contains("typo.toml"), "{err}");
+}
+
+#[test]
+fn tau_too_close_to_one_half_is_refused_with_a_suggestion() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write_case(dir.path(), "lowtau", &small_case(&[("reynolds = 100.0", "reynolds = 100000.0")]));
+    let o = hgym(&["validate", "--case", p.to_str().unwrap(), "--level", "coarse"]);
+    assert_eq!(o.status.code(), Some(2));
+    let (_, err) = text(&o);
+    assert!(
+        err.contains("tau") && err.contains("too close to 1/2") && err.contains("cells per length"),
+        "{err}"
+    );
+}
+
+#[test]
+fn mach_too_high_is_refused_with_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write_case(
+        dir.path(),
+        "fast",
+        &small_case(&[("lattice_velocity = 0.05", "lattice_velocity = 0.3")]),
+    );
+    let o = hgym(&["validate", "--case", p.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let (_, err) = text(&o);
+    assert!(err.contains("Mach") && err.contains("lower lattice_velocity"), "{err}");
+}
+
+#[test]
+fn body_larger_than_the_domain_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = write_case(dir.path(), "big", &small_case(&[("diameter = 1.0", "diameter = 45.0")]));
+    let o = hgym(&["validate", "--case", p.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let (_, err) = text(&o);
+    assert!(
+        err.contains("does not fit inside the domain") && err.contains("enlarge the domain"),
+        "{err}"
+    );
+}
+
+#[test]
+fn blow_up_exits_1_naming_step_and_cause_with_plots_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = small_case(&[
+        ("name = \"cylinder_re100\"", "name = \"blowup\""),
+        ("collision = \"regularized\"", "collision = \"bgk\""),
+        ("reynolds = 100.0", "reynolds = 2000.0"),
+        ("lattice_velocity = 0.05", "lattice_velocity = 0.15"),
+        ("coarse = 12", "coarse = 40"),
+        ("x = [0.0, 60.0]", "x = [0.0, 16.0]"),
+        ("y = [-20.0, 20.0]", "y = [-4.0, 4.0]"),
+        ("center = [20.0, 0.0]", "center = [4.0, 0.0]"),
+    ]);
+    let p = write_case(dir.path(), "blowup", &case);
+    let out = dir.path().join("out");
+    let o = hgym(&[
+        "validate",
+        "--case",
+        p.to_str().unwrap(),
+        "--level",
+        "coarse",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let (stdout, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "stdout: {stdout}\nstderr: {stderr}");
+    assert!(stdout.contains("DIVERGED") && stdout.contains("diverged at step"), "{stdout}");
+    for plot in ["forces.png", "spectrum.png", "vorticity.png"] {
+        assert!(out.join("blowup").join(plot).exists(), "{plot} missing after the blow-up");
+    }
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("blowup.json")).unwrap()).unwrap();
+    assert_eq!(report["status"], "diverged");
+    schema_check(&report);
+}
+
+#[test]
+fn an_unseen_case_file_runs_and_passes() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = repo().join("tests/cases/schaefer_turek_2d1.toml");
+    let out = dir.path().join("out");
+    let o = hgym(&[
+        "validate",
+        "--case",
+        case.to_str().unwrap(),
+        "--level",
+        "coarse",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let (stdout, stderr) = text(&o);
+    println!("{stdout}");
+    assert_eq!(o.status.code(), Some(0), "stdout: {stdout}\nstderr: {stderr}");
+    assert!(stdout.contains("mean_cd") && stdout.contains("PASS"));
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("schaefer_turek_2d1.json")).unwrap()).unwrap();
+    schema_check(&report);
+    assert_eq!(report["status"], "pass");
+    assert_eq!(report["family"], "channel");
+    // Steady flow: no shedding, so no Strouhal number.
+    let st = report["quantities"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|q| q["name"] == "strouhal")
+        .unwrap();
+    assert!(st["measured"].is_null());
+    for plot in ["forces.png", "spectrum.png", "vorticity.png"] {
+        assert!(out.join("schaefer_turek_2d1").join(plot).exists());
+    }
+}
+
+#[test]
+fn committed_validation_reports_match_the_schema() {
+    let dir = repo().join("results/validation");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let p = entry.unwrap().path();
+        if p.extension().is_some_and(|e| e == "json") {
+            let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
+            schema_check(&v);
+            n += 1;
+        }
+    }
+    assert!(n >= 2, "expected the committed cylinder reports in {}", dir.display());
+}
+
+#[test]
+fn json_output_is_machine_readable() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = repo().join("tests/cases/schaefer_turek_2d1.toml");
+    let out = dir.path().join("out");
+    let o = hgym(&[
+        "validate",
+        "--case",
+        case.to_str().unwrap(),
+        "--level",
+        "coarse",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+        "--threads",
+        "1",
+    ]);
+    assert_eq!(o.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("stdout is JSON");
+    let arr = v.as_array().unwrap();
+    assert_eq!(arr.len(), 1);
+    schema_check(&arr[0]);
+}
+
+#[test]
+fn bench_quick_reports_mlups_and_roofline_fraction() {
+    let o = hgym(&["bench", "lbm", "--quick", "--json"]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 6);
+    for r in rows {
+        assert!(r["mlups"].as_f64().unwrap() > 0.0);
+        assert!(r["roofline_fraction"].as_f64().unwrap() > 0.0);
+        assert!(r["check_error"].as_f64().unwrap() < 0.01);
+    }
+    assert_eq!(v["bytes_per_cell"], 72);
+}
