@@ -1,5 +1,9 @@
 //! STREAM-style copy bandwidth (McCalpin): `b[i] = a[i]` over arrays far larger than the caches,
 //! bytes counted as read + write (write-allocate traffic not counted, as in STREAM).
+//!
+//! The loop stores with ordinary stores, like the LBM kernel and like STREAM's C loop: it is
+//! written `b[i] = a[i] + 0.0` so the compiler cannot turn it into `memcpy`, whose non-temporal
+//! stores skip the write-allocate read and would make the roofline one the kernel cannot use.
 
 use rayon::prelude::*;
 use std::time::Instant;

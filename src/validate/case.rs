@@ -161,6 +161,10 @@ pub struct FlowSpec {
     pub lattice_velocity: f64,
     #[serde(default)]
     pub collision: Collision,
+    /// Smagorinsky constant of the subgrid viscosity (regularised operator; 0 = none). Laminar
+    /// validation cases leave it at 0; under-resolved runs at Re >= 1000 need about 0.1.
+    #[serde(default)]
+    pub smagorinsky: f64,
     /// Amplitude (fraction of U) of a transverse velocity kick near the body at t = 0.
     #[serde(default)]
     pub perturbation: f64,

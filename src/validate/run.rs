@@ -191,6 +191,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     };
     let mut cfg = D2q9Config::new(nx, ny, plan.tau, sides);
     cfg.collision = plan.collision;
+    cfg.smagorinsky = case.flow.smagorinsky;
     cfg.grid = grid;
     cfg.check_interval = 200;
     let body = build_shape(&case.geometry);

@@ -7,7 +7,7 @@
 //! general path, which reads in order: load, boundaries, moments, collide, store.
 
 use super::boundary::{bouzidi, side_value};
-use super::collision::collide;
+use super::collision::{collide_les, Relax};
 use super::domain::Sides;
 use super::lattice::{CX, CY, Q};
 
@@ -38,7 +38,7 @@ pub(crate) struct Link {
 pub(crate) struct KernelCtx<'a> {
     pub nx: usize,
     pub ny: usize,
-    pub omega: f32,
+    pub relax: Relax,
     pub fx: f32,
     pub fy: f32,
     pub periodic_x: bool,
@@ -95,7 +95,7 @@ impl KernelCtx<'_> {
 }
 
 /// One row of the step: vectorised interior, then the special nodes.
-pub(crate) fn row_kernel<const REG: bool, const FORCED: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
+pub(crate) fn row_kernel<const REG: bool, const FORCED: bool, const LES: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
     let nx = c.nx;
     let bulk = c.periodic_y || (y > 0 && y + 1 < c.ny);
     if bulk {
@@ -134,7 +134,7 @@ pub(crate) fn row_kernel<const REG: bool, const FORCED: bool>(c: &KernelCtx, src
         );
         for x in 0..n {
             let mut g = [s0[x], s1[x], s2[x], s3[x], s4[x], s5[x], s6[x], s7[x], s8[x]];
-            collide::<REG, FORCED>(&mut g, c.omega, c.fx, c.fy);
+            collide_les::<REG, FORCED, LES>(&mut g, c.relax, c.fx, c.fy);
             d0[x] = g[0];
             d1[x] = g[1];
             d2[x] = g[2];
@@ -148,12 +148,12 @@ pub(crate) fn row_kernel<const REG: bool, const FORCED: bool>(c: &KernelCtx, src
     }
     let specials = &c.specials[c.row_start[y] as usize..c.row_start[y + 1] as usize];
     for sp in specials {
-        general_node::<REG, FORCED>(c, src, row, sp.x as usize, y, sp);
+        general_node::<REG, FORCED, LES>(c, src, row, sp.x as usize, y, sp);
     }
 }
 
 /// The same row, every node through the general path (the slow oracle of the tests).
-pub(crate) fn row_reference<const REG: bool, const FORCED: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
+pub(crate) fn row_reference<const REG: bool, const FORCED: bool, const LES: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
     let specials = &c.specials[c.row_start[y] as usize..c.row_start[y + 1] as usize];
     for x in 0..c.nx {
         let plain = Special {
@@ -163,13 +163,20 @@ pub(crate) fn row_reference<const REG: bool, const FORCED: bool>(c: &KernelCtx, 
             link_end: 0,
         };
         let sp = specials.iter().find(|s| s.x as usize == x).unwrap_or(&plain);
-        general_node::<REG, FORCED>(c, src, row, x, y, sp);
+        general_node::<REG, FORCED, LES>(c, src, row, x, y, sp);
     }
 }
 
 /// The general path for one node: load with boundaries, collide, store.
 #[inline]
-fn general_node<const REG: bool, const FORCED: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], x: usize, y: usize, sp: &Special) {
+fn general_node<const REG: bool, const FORCED: bool, const LES: bool>(
+    c: &KernelCtx,
+    src: &[f32],
+    row: &mut [f32],
+    x: usize,
+    y: usize,
+    sp: &Special,
+) {
     let nx = c.nx;
     if sp.solid {
         for i in 0..Q {
@@ -195,7 +202,7 @@ fn general_node<const REG: bool, const FORCED: bool>(c: &KernelCtx, src: &[f32],
             g[k] = side_value(c, src, x, y, k);
         }
     }
-    collide::<REG, FORCED>(&mut g, c.omega, c.fx, c.fy);
+    collide_les::<REG, FORCED, LES>(&mut g, c.relax, c.fx, c.fy);
     for i in 0..Q {
         row[i * nx + x] = g[i];
     }

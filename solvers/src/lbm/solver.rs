@@ -5,7 +5,7 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use super::check::{scan_row, RowStat};
-use super::collision::{equilibrium, moments, Collision};
+use super::collision::{equilibrium, moments, Collision, Relax};
 use super::domain::{Grid, Side, Sides};
 use super::error::LbmError;
 use super::forces::link_forces;
@@ -22,6 +22,9 @@ pub struct D2q9Config {
     /// Relaxation time; `nu = (tau - 1/2) / 3`.
     pub tau: f64,
     pub collision: Collision,
+    /// Smagorinsky constant `C_s` of the subgrid viscosity (regularised operator only; 0 = none,
+    /// 0.1-0.17 usual). Needed for under-resolved runs at Re >= 1000.
+    pub smagorinsky: f64,
     pub sides: Sides,
     /// Uniform body force per unit volume (lattice units), Guo forcing; zero for none.
     pub body_force: [f64; 2],
@@ -43,6 +46,7 @@ impl D2q9Config {
             ny,
             tau,
             collision: Collision::Regularized,
+            smagorinsky: 0.0,
             sides,
             body_force: [0.0, 0.0],
             grid: Grid::lattice(),
@@ -67,7 +71,7 @@ pub struct WallPoint {
 /// D2Q9 lattice Boltzmann solver (see the module docs for the scheme).
 pub struct D2q9 {
     cfg: D2q9Config,
-    omega: f32,
+    relax: Relax,
     /// Current post-collision populations, shifted (`g = f - w`), row-blocked SoA.
     f: Vec<f32>,
     /// The other half of the A-B pair.
@@ -100,7 +104,7 @@ impl std::fmt::Debug for D2q9 {
 /// destination array can be borrowed mutably beside it).
 fn kernel_ctx<'a>(
     cfg: &'a D2q9Config,
-    omega: f32,
+    relax: Relax,
     solid: &'a [bool],
     specials: &'a [Special],
     row_start: &'a [u32],
@@ -110,7 +114,7 @@ fn kernel_ctx<'a>(
     KernelCtx {
         nx: cfg.nx,
         ny: cfg.ny,
-        omega,
+        relax,
         fx: cfg.body_force[0] as f32,
         fy: cfg.body_force[1] as f32,
         periodic_x: cfg.sides.west == Side::Periodic,
@@ -160,6 +164,18 @@ impl D2q9 {
                     cfg.collision.name(),
                     cfg.collision.min_tau_margin()
                 ),
+            ));
+        }
+        if !(cfg.smagorinsky.is_finite() && (0.0..=1.0).contains(&cfg.smagorinsky)) {
+            return Err(config_error(
+                "smagorinsky",
+                format!("C_s = {} must be in [0, 1] (0.1-0.17 is usual)", cfg.smagorinsky),
+            ));
+        }
+        if cfg.smagorinsky > 0.0 && cfg.collision == Collision::Bgk {
+            return Err(config_error(
+                "smagorinsky",
+                "the subgrid model is built into the regularised operator; use collision = regularized",
             ));
         }
         let s = &cfg.sides;
@@ -284,10 +300,10 @@ impl D2q9 {
         }
         row_start.push(specials.len() as u32);
 
-        let omega = (1.0 / cfg.tau) as f32;
+        let relax = Relax::new(cfg.tau, cfg.smagorinsky);
         let n_bodies = bodies.len();
         let mut solver = D2q9 {
-            omega,
+            relax,
             f: vec![0.0; nx * ny * Q],
             f_next: vec![0.0; nx * ny * Q],
             solid,
@@ -332,7 +348,7 @@ impl D2q9 {
     pub fn step(&mut self) -> Result<(), LbmError> {
         let ctx = kernel_ctx(
             &self.cfg,
-            self.omega,
+            self.relax,
             &self.solid,
             &self.specials,
             &self.row_start,
@@ -343,11 +359,14 @@ impl D2q9 {
         let row_len = Q * self.cfg.nx;
         let forced = self.cfg.body_force != [0.0, 0.0];
         let rows = self.f_next.par_chunks_mut(row_len).enumerate().with_min_len(4);
-        match (self.cfg.collision, forced) {
-            (Collision::Bgk, false) => rows.for_each(|(y, row)| row_kernel::<false, false>(&ctx, src, row, y)),
-            (Collision::Bgk, true) => rows.for_each(|(y, row)| row_kernel::<false, true>(&ctx, src, row, y)),
-            (Collision::Regularized, false) => rows.for_each(|(y, row)| row_kernel::<true, false>(&ctx, src, row, y)),
-            (Collision::Regularized, true) => rows.for_each(|(y, row)| row_kernel::<true, true>(&ctx, src, row, y)),
+        let les = self.cfg.smagorinsky > 0.0;
+        match (self.cfg.collision, forced, les) {
+            (Collision::Bgk, false, _) => rows.for_each(|(y, row)| row_kernel::<false, false, false>(&ctx, src, row, y)),
+            (Collision::Bgk, true, _) => rows.for_each(|(y, row)| row_kernel::<false, true, false>(&ctx, src, row, y)),
+            (Collision::Regularized, false, false) => rows.for_each(|(y, row)| row_kernel::<true, false, false>(&ctx, src, row, y)),
+            (Collision::Regularized, true, false) => rows.for_each(|(y, row)| row_kernel::<true, true, false>(&ctx, src, row, y)),
+            (Collision::Regularized, false, true) => rows.for_each(|(y, row)| row_kernel::<true, false, true>(&ctx, src, row, y)),
+            (Collision::Regularized, true, true) => rows.for_each(|(y, row)| row_kernel::<true, true, true>(&ctx, src, row, y)),
         }
         link_forces(&ctx, src, &mut self.body_forces);
         std::mem::swap(&mut self.f, &mut self.f_next);
@@ -547,7 +566,7 @@ impl D2q9 {
     pub fn step_reference(&mut self) -> Result<(), LbmError> {
         let ctx = kernel_ctx(
             &self.cfg,
-            self.omega,
+            self.relax,
             &self.solid,
             &self.specials,
             &self.row_start,
@@ -557,11 +576,14 @@ impl D2q9 {
         let forced = self.cfg.body_force != [0.0, 0.0];
         let row_len = Q * self.cfg.nx;
         for (y, row) in self.f_next.chunks_mut(row_len).enumerate() {
-            match (self.cfg.collision, forced) {
-                (Collision::Bgk, false) => super::kernel::row_reference::<false, false>(&ctx, &self.f, row, y),
-                (Collision::Bgk, true) => super::kernel::row_reference::<false, true>(&ctx, &self.f, row, y),
-                (Collision::Regularized, false) => super::kernel::row_reference::<true, false>(&ctx, &self.f, row, y),
-                (Collision::Regularized, true) => super::kernel::row_reference::<true, true>(&ctx, &self.f, row, y),
+            let les = self.cfg.smagorinsky > 0.0;
+            match (self.cfg.collision, forced, les) {
+                (Collision::Bgk, false, _) => super::kernel::row_reference::<false, false, false>(&ctx, &self.f, row, y),
+                (Collision::Bgk, true, _) => super::kernel::row_reference::<false, true, false>(&ctx, &self.f, row, y),
+                (Collision::Regularized, false, false) => super::kernel::row_reference::<true, false, false>(&ctx, &self.f, row, y),
+                (Collision::Regularized, true, false) => super::kernel::row_reference::<true, true, false>(&ctx, &self.f, row, y),
+                (Collision::Regularized, false, true) => super::kernel::row_reference::<true, false, true>(&ctx, &self.f, row, y),
+                (Collision::Regularized, true, true) => super::kernel::row_reference::<true, true, true>(&ctx, &self.f, row, y),
             }
         }
         link_forces(&ctx, &self.f, &mut self.body_forces);
