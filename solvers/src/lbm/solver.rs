@@ -386,7 +386,7 @@ impl D2q9 {
                 });
             }
         }
-        if self.cfg.check_interval > 0 && self.time % self.cfg.check_interval == 0 {
+        if self.cfg.check_interval > 0 && self.time.is_multiple_of(self.cfg.check_interval) {
             self.check()?;
         }
         Ok(())
