@@ -9,5 +9,6 @@
 //! and are converted by [`hgym_solvers::lbm::Units`].
 
 pub mod bench;
+pub mod env;
 pub mod report;
 pub mod validate;

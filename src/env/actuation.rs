@@ -1,0 +1,271 @@
+//! Actuators and the temporal smoothing of control actions, as the HydroGym paper defines them
+//! (Methods, "Temporal smoothing of control actions", "Synthetic jet actuation", "Surface rotation
+//! actuation").
+//!
+//! - Smoothing: `A(t) = A_old + (A_new - A_old) R(tau)`, `tau = (t - t_update) / (N_r dt)` in
+//!   `[0, 1]`, with `R_tanh(tau) = (tanh(b (tau - 1/2)) + 1) / 2` or
+//!   `R_exp(tau) = (e^{k tau} - 1) / (e^k - 1)`. The paper's tanh ramp is not exactly 0 and 1 at
+//!   the ends (`R(0) = (1 - tanh(b/2)) / 2`), which would make `A(t)` jump by
+//!   `(A_new - A_old)(1 - R(1))` at every update; we rescale it to `(R - R(0)) / (R(1) - R(0))` so
+//!   the actuation is continuous. Default: tanh with `b = 10`.
+//! - Jet `j` (centre `x_j`, direction `t_j = (cos a_j, sin a_j)`, width `W_j`):
+//!   `u_w(x) = A_j (1 - (2 d_perp / W_j)^2) t_j` where `d_perp` is the distance from `x` to the jet's
+//!   centre line, for `d_perp <= W_j / 2` and `|x - x_j| <= W_j` (the second condition keeps a jet
+//!   on its own side of the body).
+//! - Rotation about `x_c` with angular velocity `w`: `u_w = w (-(y - y_c), x - x_c)`.
+//!
+//! Velocities here are non-dimensional (units of U); [`apply`] converts to lattice units.
+
+use serde::{Deserialize, Serialize};
+
+use hgym_solvers::lbm::{D2q9, Units, WallPoint};
+
+/// Normalised ramp `R(tau)`, `R(0) = 0`, `R(1) = 1`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Ramp {
+    /// S-shaped: `(tanh(b (tau - 1/2)) + 1) / 2`, rescaled to end exactly at 0 and 1.
+    Tanh { b: f64 },
+    /// Slow start, fast end: `(e^{k tau} - 1) / (e^k - 1)`.
+    Exponential { k: f64 },
+}
+
+impl Default for Ramp {
+    fn default() -> Self {
+        Ramp::Tanh { b: 10.0 }
+    }
+}
+
+impl Ramp {
+    /// `R(tau)` for `tau` clamped to `[0, 1]`.
+    pub fn weight(&self, tau: f64) -> f64 {
+        let tau = tau.clamp(0.0, 1.0);
+        match *self {
+            Ramp::Tanh { b } => {
+                let r = |s: f64| 0.5 * ((b * (s - 0.5)).tanh() + 1.0);
+                let (r0, r1) = (r(0.0), r(1.0));
+                if r1 - r0 > 0.0 {
+                    (r(tau) - r0) / (r1 - r0)
+                } else {
+                    tau
+                }
+            }
+            Ramp::Exponential { k } => {
+                if k.abs() < 1e-12 {
+                    tau
+                } else {
+                    (k * tau).exp_m1() / k.exp_m1()
+                }
+            }
+        }
+    }
+
+    /// `A(tau) = A_old + (A_new - A_old) R(tau)`.
+    pub fn blend(&self, a_old: f64, a_new: f64, tau: f64) -> f64 {
+        a_old + (a_new - a_old) * self.weight(tau)
+    }
+}
+
+/// A synthetic jet on a body's wall.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Jet {
+    /// Centre of the jet's exit on the wall.
+    pub center: [f64; 2],
+    /// Blowing direction, degrees from +x.
+    pub angle_deg: f64,
+    /// Exit width (chord across the slot).
+    pub width: f64,
+}
+
+impl Jet {
+    /// A jet on a circle of `radius` around `center`, centred at polar angle `theta_deg`, blowing
+    /// radially outward, spanning `span_deg` of the circumference.
+    pub fn on_circle(center: [f64; 2], radius: f64, theta_deg: f64, span_deg: f64) -> Self {
+        let t = theta_deg.to_radians();
+        Jet {
+            center: [center[0] + radius * t.cos(), center[1] + radius * t.sin()],
+            angle_deg: theta_deg,
+            width: 2.0 * radius * (0.5 * span_deg.to_radians()).sin(),
+        }
+    }
+
+    /// The spatial profile `S_j(x)` (zero outside the jet).
+    pub fn profile(&self, p: [f64; 2]) -> [f64; 2] {
+        let a = self.angle_deg.to_radians();
+        let t = [a.cos(), a.sin()];
+        let r = [p[0] - self.center[0], p[1] - self.center[1]];
+        let along = r[0] * t[0] + r[1] * t[1];
+        let d_perp = (r[0] - along * t[0]).hypot(r[1] - along * t[1]);
+        let half = 0.5 * self.width;
+        if d_perp > half || r[0].hypot(r[1]) > self.width {
+            return [0.0, 0.0];
+        }
+        let s = 1.0 - (d_perp / half).powi(2);
+        [s * t[0], s * t[1]]
+    }
+}
+
+/// Surface rotation velocity `w (-(y - y_c), x - x_c)`.
+pub fn rotation(omega: f64, center: [f64; 2], p: [f64; 2]) -> [f64; 2] {
+    [-omega * (p[1] - center[1]), omega * (p[0] - center[0])]
+}
+
+/// What moves one body's wall: jets with their magnitudes, and an angular velocity (all in units
+/// of U and U/L).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WallMotion<'a> {
+    pub jets: &'a [Jet],
+    pub amplitudes: &'a [f64],
+    pub rotation: Option<([f64; 2], f64)>,
+}
+
+impl WallMotion<'_> {
+    /// Non-dimensional wall velocity at a wall point.
+    pub fn velocity(&self, wp: &WallPoint) -> [f64; 2] {
+        let mut u = [0.0, 0.0];
+        for (jet, a) in self.jets.iter().zip(self.amplitudes) {
+            let s = jet.profile(wp.position);
+            u[0] += a * s[0];
+            u[1] += a * s[1];
+        }
+        if let Some((c, w)) = self.rotation {
+            let r = rotation(w, c, wp.position);
+            u[0] += r[0];
+            u[1] += r[1];
+        }
+        u
+    }
+}
+
+/// Sets the wall velocity of every link of `body` from `motion`, converted to lattice units.
+pub fn apply(solver: &mut D2q9, body: usize, motion: &WallMotion, units: &Units) {
+    solver.set_wall_velocity(body, |wp| {
+        let u = motion.velocity(wp);
+        [units.lattice_velocity(u[0]), units.lattice_velocity(u[1])]
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hgym_solvers::geometry::{Circle, Shape};
+    use hgym_solvers::lbm::{D2q9Config, Grid, Side, Sides};
+    use std::sync::Arc;
+
+    #[test]
+    fn ramps_start_at_zero_end_at_one_and_are_monotone() {
+        for ramp in [
+            Ramp::Tanh { b: 10.0 },
+            Ramp::Tanh { b: 2.0 },
+            Ramp::Exponential { k: 3.0 },
+            Ramp::Exponential { k: -2.0 },
+        ] {
+            assert!(ramp.weight(0.0).abs() < 1e-15, "{ramp:?}");
+            assert!((ramp.weight(1.0) - 1.0).abs() < 1e-15, "{ramp:?}");
+            let mut prev = 0.0;
+            for j in 1..=1000 {
+                let w = ramp.weight(j as f64 / 1000.0);
+                assert!(w >= prev - 1e-15, "{ramp:?} not monotone");
+                prev = w;
+            }
+        }
+    }
+
+    /// A sequence of control updates gives a continuous actuation: at each update the new ramp
+    /// starts exactly where the old one ended.
+    #[test]
+    fn smoothed_actuation_is_continuous_across_updates() {
+        let ramp = Ramp::default();
+        let actions = [0.0, 1.0, -0.5, 0.25, 0.25, -1.0];
+        let n = 50;
+        let mut series = Vec::new();
+        for w in actions.windows(2) {
+            for s in 0..=n {
+                series.push(ramp.blend(w[0], w[1], s as f64 / n as f64));
+            }
+        }
+        // Between the last sample of one interval and the first of the next there is no jump.
+        for k in 1..actions.len() - 1 {
+            let end = series[k * (n + 1) - 1];
+            let start = series[k * (n + 1)];
+            assert_eq!(end, start, "jump at update {k}");
+            assert_eq!(end, actions[k]);
+        }
+        // And within an interval the largest step is bounded by the ramp's steepest slope.
+        let max_step = series.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
+        assert!(max_step < 1.5 * 0.4, "max step {max_step}");
+    }
+
+    #[test]
+    fn jet_profile_is_parabolic_and_local() {
+        let jet = Jet::on_circle([0.0, 0.0], 0.5, 90.0, 10.0);
+        let top = jet.profile([0.0, 0.5]);
+        assert!((top[1] - 1.0).abs() < 1e-12 && top[0].abs() < 1e-12);
+        // Edge of the slot: zero; the opposite side of the cylinder: zero.
+        let edge = [0.5 * (95f64).to_radians().cos(), 0.5 * (95f64).to_radians().sin()];
+        assert!(jet.profile(edge)[1].abs() < 1e-9);
+        assert_eq!(jet.profile([0.0, -0.5]), [0.0, 0.0]);
+    }
+
+    #[test]
+    fn rotation_is_tangential() {
+        let u = rotation(2.0, [1.0, 1.0], [1.5, 1.0]);
+        assert!((u[0]).abs() < 1e-15 && (u[1] - 1.0).abs() < 1e-15);
+    }
+
+    /// Zero-net-mass-flux jet pair at 90 and 270 degrees on a cylinder placed symmetrically on the
+    /// grid: the mass the moving-wall terms inject sums to zero to round-off, while one jet alone
+    /// injects a finite amount.
+    #[test]
+    fn znmf_jet_pair_injects_no_net_mass() {
+        let units = Units {
+            cells_per_length: 16.0,
+            u_lattice: 0.05,
+            reynolds: 100.0,
+        };
+        let (nx, ny) = (160, 96);
+        let dx = 1.0 / 16.0;
+        let grid = Grid {
+            origin: [0.5 * dx, -0.5 * (ny as f64 - 1.0) * dx],
+            dx,
+        };
+        let center = [3.0, 0.0];
+        let sides = Sides {
+            west: Side::Wall,
+            east: Side::Wall,
+            south: Side::Wall,
+            north: Side::Wall,
+        };
+        let mut cfg = D2q9Config::new(nx, ny, units.tau(), sides);
+        cfg.grid = grid;
+        let body: Arc<dyn Shape> = Arc::new(Circle { center, radius: 0.5 });
+        let mut s = D2q9::new(cfg, vec![body]).unwrap();
+        let jets = [Jet::on_circle(center, 0.5, 90.0, 10.0), Jet::on_circle(center, 0.5, 270.0, 10.0)];
+        let a = 0.8;
+        apply(
+            &mut s,
+            0,
+            &WallMotion {
+                jets: &jets,
+                amplitudes: &[a, -a],
+                rotation: None,
+            },
+            &units,
+        );
+        let pair = s.wall_mass_source(0);
+        apply(
+            &mut s,
+            0,
+            &WallMotion {
+                jets: &jets[..1],
+                amplitudes: &[a],
+                rotation: None,
+            },
+            &units,
+        );
+        let one = s.wall_mass_source(0);
+        println!("ZNMF pair: net injected mass per step {pair:.3e}; one jet alone {one:.3e}");
+        assert!(one.abs() > 1e-4, "a single jet must inject mass ({one})");
+        assert!(pair.abs() < 1e-12 * one.abs().max(1.0), "ZNMF pair injects {pair:e}");
+    }
+}
