@@ -10,6 +10,7 @@
 //! Both arrays hold *post-collision* populations: after a step, `f` holds `f*(x, t+1)`. Moments
 //! (density, momentum) are invariant under collision, so they can be read from either.
 
+mod aligned;
 pub mod boundary;
 mod check;
 pub mod collision;

@@ -4,6 +4,7 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
+use super::aligned::AlignedVec;
 use super::check::{scan_row, RowStat};
 use super::collision::{equilibrium, moments, Collision, Relax};
 use super::domain::{Grid, Side, Sides};
@@ -36,6 +37,9 @@ pub struct D2q9Config {
     /// Allowed density range and maximum lattice speed before the run counts as diverged.
     pub rho_bounds: [f32; 2],
     pub u_max: f32,
+    /// Non-temporal stores for the interior: `None` decides by size
+    /// ([`STREAM_STORES_ABOVE_BYTES`]). A performance knob only: results are bitwise the same.
+    pub stream_stores: Option<bool>,
 }
 
 impl D2q9Config {
@@ -53,6 +57,7 @@ impl D2q9Config {
             check_interval: 100,
             rho_bounds: [0.5, 2.0],
             u_max: 0.5,
+            stream_stores: None,
         }
     }
 }
@@ -73,9 +78,9 @@ pub struct D2q9 {
     cfg: D2q9Config,
     relax: Relax,
     /// Current post-collision populations, shifted (`g = f - w`), row-blocked SoA.
-    f: Vec<f32>,
+    f: AlignedVec,
     /// The other half of the A-B pair.
-    f_next: Vec<f32>,
+    f_next: AlignedVec,
     solid: Vec<bool>,
     specials: Vec<Special>,
     row_start: Vec<u32>,
@@ -125,8 +130,16 @@ fn kernel_ctx<'a>(
         row_start,
         links,
         velocity_scale,
+        stream_stores: cfg.stream_stores.unwrap_or(cfg.nx * cfg.ny * Q * 4 * 2 > STREAM_STORES_ABOVE_BYTES),
     }
 }
+
+/// Above this size of the two population arrays the kernel writes with non-temporal stores
+/// (no write-allocate read: 72 instead of 108 bytes of traffic per node). Below it the arrays
+/// live in the last-level cache (32 MB here), where ordinary stores are faster because the next
+/// step reads the values back from the cache. The choice depends only on the grid size and
+/// never changes a result.
+pub const STREAM_STORES_ABOVE_BYTES: usize = 48 << 20;
 
 fn config_error(field: &'static str, message: impl Into<String>) -> LbmError {
     LbmError::Config {
@@ -304,8 +317,8 @@ impl D2q9 {
         let n_bodies = bodies.len();
         let mut solver = D2q9 {
             relax,
-            f: vec![0.0; nx * ny * Q],
-            f_next: vec![0.0; nx * ny * Q],
+            f: AlignedVec::zeros(nx * ny * Q),
+            f_next: AlignedVec::zeros(nx * ny * Q),
             solid,
             specials,
             row_start,
