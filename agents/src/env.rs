@@ -7,8 +7,31 @@ use thiserror::Error;
 use crate::spaces::BoxSpace;
 
 /// Extra facts of a reset or step: at least `t`, force coefficients and the physical actuation
-/// for flow environments. Ordered map so that serialised output is deterministic.
-pub type Info = BTreeMap<String, f64>;
+/// for flow environments (numbers), and messages such as the reason a run diverged (text).
+/// Ordered maps, so that printed output is deterministic.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Info {
+    pub values: BTreeMap<String, f64>,
+    pub text: BTreeMap<String, String>,
+}
+
+impl Info {
+    pub fn set(&mut self, key: &str, value: f64) {
+        self.values.insert(key.to_string(), value);
+    }
+
+    pub fn get(&self, key: &str) -> Option<f64> {
+        self.values.get(key).copied()
+    }
+
+    pub fn set_text(&mut self, key: &str, value: impl Into<String>) {
+        self.text.insert(key.to_string(), value.into());
+    }
+
+    pub fn text(&self, key: &str) -> Option<&str> {
+        self.text.get(key).map(|s| s.as_str())
+    }
+}
 
 /// What one `step` returns.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,7 +1,15 @@
 //! Flow environments: where solvers (`hgym-solvers`) meet the `Env` contract (`hgym-agents`).
 //!
-//! Built so far: [`actuation`], the paper's actuators (synthetic jets, surface rotation) and the
-//! temporal smoothing of control actions, applied to a solver's wall links. The families, the
-//! registry of IDs and the `Env` implementations come next (issue "Flow environments").
+//! - [`spec`]: the serialisable description of an environment (its hash keys caches and results);
+//! - [`registry`]: every ID; [`cylinder`]: the cylinder family's specs;
+//! - [`lbm_env`]: the `Env` implementation for 2D lattice-Boltzmann families;
+//! - [`actuation`]: jets, rotation, and the temporal smoothing of actions.
 
 pub mod actuation;
+pub mod cylinder;
+pub mod lbm_env;
+pub mod registry;
+pub mod spec;
+
+pub use lbm_env::LbmEnv;
+pub use spec::EnvSpec;

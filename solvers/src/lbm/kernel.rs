@@ -101,7 +101,7 @@ impl KernelCtx<'_> {
 /// aligned, see `AlignedVec`).
 #[inline]
 fn nt_rows_possible(row: &[f32], nx: usize) -> bool {
-    cfg!(all(target_arch = "x86_64", target_feature = "avx")) && nx % 8 == 0 && (row.as_ptr() as usize) % 32 == 0
+    cfg!(all(target_arch = "x86_64", target_feature = "avx")) && nx.is_multiple_of(8) && (row.as_ptr() as usize).is_multiple_of(32)
 }
 
 /// Interior of a row, ordinary stores: `x = 1 .. nx-2`, `s[i][x - 1]` streams into node `x`.
@@ -234,7 +234,7 @@ fn stream_aligned(dst: &mut [f32], src: &[f32]) {
     {
         use core::arch::x86_64::{_mm256_loadu_ps, _mm256_stream_ps};
         assert!(
-            dst.len() % 8 == 0 && (dst.as_ptr() as usize) % 32 == 0,
+            dst.len().is_multiple_of(8) && (dst.as_ptr() as usize).is_multiple_of(32),
             "stream_aligned: unaligned destination"
         );
         for k in (0..dst.len()).step_by(8) {

@@ -1,0 +1,383 @@
+//! The `Env` of every 2D lattice-Boltzmann family: builds the solver from a spec, reaches the
+//! attractor once (cached), and runs control intervals with smoothed actuation.
+//!
+//! - `reset(seed)`: loads the developed-flow state (spun up on first use, then cached in memory
+//!   and on disk under the spec hash and level) and advances it by a seed-dependent number of
+//!   half control intervals (0-63), so different seeds start at different shedding phases and the
+//!   same seed always starts at the same one, bitwise.
+//! - `step(action)`: NaN or infinite components are an error; finite values outside [-1, 1] are
+//!   clipped and counted in `info["clipped"]`. Over the interval's `n` solver steps the actuation
+//!   goes from the previous to the new value with the spec's ramp. The reward uses the
+//!   interval-averaged force coefficients, which `info` reports (`C_D`, `C_L`, and per body
+//!   `C_D_b`, `C_L_b`), with `t` and the physical actuation `actuation_k` (units of U or U/D).
+//!   A solver blow-up ends the episode with `terminated = true`, `info["diverged"] = 1` and the
+//!   reason in `info.text["reason"]`.
+
+use std::path::PathBuf;
+
+use hgym_agents::{BoxSpace, Env, EnvError, Info, StepResult};
+use hgym_solvers::lbm::{D2q9, D2q9Config, Grid, Side, Sides, Units};
+
+use super::actuation::{apply, Jet, WallMotion};
+use super::spec::{ActuationSpec, EnvSpec, RewardSpec};
+use crate::validate::case::{BoundaryKind, GeometrySpec, Level};
+use crate::validate::run::build_shape;
+
+/// splitmix64 (Steele, Lea & Flood 2014): a seed -> a well-mixed 64-bit value.
+fn splitmix64(seed: u64) -> u64 {
+    let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+pub struct LbmEnv {
+    spec: EnvSpec,
+    level: Level,
+    units: Units,
+    solver: D2q9,
+    steps_per_action: u64,
+    jets: Vec<Jet>,
+    centers: Vec<[f64; 2]>,
+    a_old: Vec<f64>,
+    actions_taken: usize,
+    live: bool,
+    attractor: Option<Vec<f32>>,
+    cache_dir: Option<PathBuf>,
+    t0: u64,
+}
+
+fn backend(e: impl std::fmt::Display) -> EnvError {
+    EnvError::Backend(e.to_string())
+}
+
+impl LbmEnv {
+    /// Builds the solver for `spec` at `level`; `cache_dir` keeps developed-flow states between
+    /// processes (none: in memory only).
+    pub fn new(spec: EnvSpec, level: Level, cache_dir: Option<PathBuf>) -> Result<Self, EnvError> {
+        let n = spec.cells_per_length(level) as f64;
+        let units = Units {
+            cells_per_length: n,
+            u_lattice: spec.lattice_velocity,
+            reynolds: spec.reynolds,
+        };
+        let d = &spec.domain;
+        let dx = 1.0 / n;
+        let (nx, ny) = (((d.x[1] - d.x[0]) * n).round() as usize, ((d.y[1] - d.y[0]) * n).round() as usize);
+        let grid = Grid {
+            origin: [d.x[0] + 0.5 * dx, d.y[0] + 0.5 * dx],
+            dx,
+        };
+        let u = spec.lattice_velocity as f32;
+        let side = |k: BoundaryKind| match k {
+            BoundaryKind::Inlet => Side::Velocity {
+                profile: vec![[u, 0.0]; ny],
+            },
+            BoundaryKind::Outlet => Side::Outlet,
+            BoundaryKind::Periodic => Side::Periodic,
+            BoundaryKind::Wall => Side::Wall,
+            BoundaryKind::FreeSlip => Side::FreeSlip,
+        };
+        let b = &spec.boundaries;
+        let sides = Sides {
+            west: side(b.west),
+            east: side(b.east),
+            south: side(b.south),
+            north: side(b.north),
+        };
+        let mut cfg = D2q9Config::new(nx, ny, units.tau(), sides);
+        cfg.collision = spec.collision;
+        cfg.smagorinsky = spec.smagorinsky;
+        cfg.grid = grid;
+        cfg.check_interval = 100;
+        let bodies = spec.bodies.iter().map(build_shape).collect();
+        let solver = D2q9::new(cfg, bodies).map_err(backend)?;
+        let steps_per_action = units.steps(spec.control_interval).max(1);
+        let circle = |i: usize| match spec.bodies.get(i) {
+            Some(GeometrySpec::Circle { center, diameter }) => Ok((*center, 0.5 * diameter)),
+            _ => Err(EnvError::Backend(format!("{}: actuated body {i} must be a circle", spec.id))),
+        };
+        let (jets, centers) = match &spec.actuation {
+            ActuationSpec::ZnmfJets {
+                body,
+                angles_deg,
+                span_deg,
+                ..
+            } => {
+                let (c, r) = circle(*body)?;
+                (angles_deg.iter().map(|a| Jet::on_circle(c, r, *a, *span_deg)).collect(), vec![])
+            }
+            ActuationSpec::Rotation { bodies, .. } => (vec![], bodies.iter().map(|&i| circle(i).map(|c| c.0)).collect::<Result<_, _>>()?),
+        };
+        let act_dim = spec.act_dim();
+        Ok(LbmEnv {
+            spec,
+            level,
+            units,
+            solver,
+            steps_per_action,
+            jets,
+            centers,
+            a_old: vec![0.0; act_dim],
+            actions_taken: 0,
+            live: false,
+            attractor: None,
+            cache_dir,
+            t0: 0,
+        })
+    }
+
+    pub fn spec(&self) -> &EnvSpec {
+        &self.spec
+    }
+
+    pub fn steps_per_action(&self) -> u64 {
+        self.steps_per_action
+    }
+
+    pub fn solver(&self) -> &D2q9 {
+        &self.solver
+    }
+
+    /// Sets the wall velocities for physical actuation `a` (units of U or U/D).
+    fn actuate(&mut self, a: &[f64]) {
+        let n_bodies = self.spec.bodies.len();
+        for b in 0..n_bodies {
+            let motion = match &self.spec.actuation {
+                ActuationSpec::ZnmfJets { body, .. } if *body == b => {
+                    // One action: blowing at the first jet, the same suction at the second.
+                    WallMotion {
+                        jets: &self.jets,
+                        amplitudes: &[a[0], -a[0]],
+                        rotation: None,
+                    }
+                }
+                ActuationSpec::Rotation { bodies, .. } => match bodies.iter().position(|&i| i == b) {
+                    Some(k) => WallMotion {
+                        jets: &[],
+                        amplitudes: &[],
+                        rotation: Some((self.centers[k], a[k])),
+                    },
+                    None => WallMotion::default(),
+                },
+                _ => WallMotion::default(),
+            };
+            apply(&mut self.solver, b, &motion, &self.units);
+        }
+    }
+
+    fn bound(&self) -> f64 {
+        match &self.spec.actuation {
+            ActuationSpec::ZnmfJets { max_velocity, .. } => *max_velocity,
+            ActuationSpec::Rotation { max_omega, .. } => *max_omega,
+        }
+    }
+
+    fn cache_file(&self) -> Option<PathBuf> {
+        let hash = self.spec.hash();
+        self.cache_dir
+            .as_ref()
+            .map(|d| d.join(format!("{}-{}-{}.f32", self.spec.id, self.level.name(), &hash[..16])))
+    }
+
+    /// The developed flow: from memory, from the disk cache, or by spinning up.
+    fn attractor(&mut self) -> Result<Vec<f32>, EnvError> {
+        if let Some(a) = &self.attractor {
+            return Ok(a.clone());
+        }
+        let want = self.solver.populations().len();
+        if let Some(path) = self.cache_file() {
+            if let Ok(bytes) = std::fs::read(&path) {
+                if bytes.len() == 4 * want {
+                    let state: Vec<f32> = bytes
+                        .chunks_exact(4)
+                        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                        .collect();
+                    self.attractor = Some(state.clone());
+                    return Ok(state);
+                }
+            }
+        }
+        // Spin up from the uniform flow with a transverse kick behind the first body.
+        let u = self.spec.lattice_velocity;
+        let c = self.spec.bodies.first().map(|b| b.center()).unwrap_or([0.0, 0.0]);
+        self.solver.init_with(|x, y| {
+            let r2 = (x - c[0] - 1.0).powi(2) + (y - c[1] - 0.25).powi(2);
+            (1.0, u, 0.3 * u * (-4.0 * r2).exp())
+        });
+        self.actuate(&vec![0.0; self.spec.act_dim()]);
+        let steps = self.units.steps(self.spec.spin_up);
+        self.solver
+            .advance(steps)
+            .map_err(|e| EnvError::Backend(format!("{}: spin-up diverged: {e}", self.spec.id)))?;
+        let state = self.solver.populations().to_vec();
+        if let Some(path) = self.cache_file() {
+            if let Some(dir) = path.parent() {
+                let _ = std::fs::create_dir_all(dir);
+            }
+            let bytes: Vec<u8> = state.iter().flat_map(|v| v.to_le_bytes()).collect();
+            // Write then rename, so a crash never leaves a truncated cache file.
+            let tmp = path.with_extension("tmp");
+            if std::fs::write(&tmp, bytes).is_ok() {
+                let _ = std::fs::rename(&tmp, &path);
+            }
+        }
+        self.attractor = Some(state.clone());
+        Ok(state)
+    }
+
+    /// Raw probe values (u, v, p per probe; units of U and rho U^2).
+    pub fn raw_observation(&self) -> Result<Vec<f64>, EnvError> {
+        let mut obs = Vec::with_capacity(self.spec.obs_dim());
+        for p in &self.spec.probes {
+            let [rho, ux, uy] = self.solver.probe(*p).map_err(backend)?;
+            obs.push(self.units.velocity(ux));
+            obs.push(self.units.velocity(uy));
+            obs.push(self.units.pressure(rho));
+        }
+        Ok(obs)
+    }
+
+    fn observation(&self) -> Result<Vec<f64>, EnvError> {
+        let mut obs = self.raw_observation()?;
+        let n = &self.spec.normalization;
+        if n.mean.len() == obs.len() && n.scale.len() == obs.len() {
+            for ((o, m), s) in obs.iter_mut().zip(&n.mean).zip(&n.scale) {
+                *o = (*o - m) / s;
+            }
+        }
+        Ok(obs)
+    }
+
+    fn time(&self) -> f64 {
+        (self.solver.time() - self.t0) as f64 * self.units.time_per_step()
+    }
+}
+
+impl Env for LbmEnv {
+    /// Probe values; `[-5, 5]` once calibrated (3-sigma scaling), unbounded before.
+    fn observation_space(&self) -> BoxSpace {
+        let n = self.spec.obs_dim();
+        if self.spec.normalization.mean.len() == n {
+            BoxSpace::uniform(n, -5.0, 5.0)
+        } else {
+            BoxSpace::uniform(n, f64::NEG_INFINITY, f64::INFINITY)
+        }
+    }
+
+    fn action_space(&self) -> BoxSpace {
+        BoxSpace::unit(self.spec.act_dim())
+    }
+
+    fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
+        let state = self.attractor()?;
+        self.solver.set_populations(&state, 0).map_err(backend)?;
+        self.a_old = vec![0.0; self.spec.act_dim()];
+        let zero = self.a_old.clone();
+        self.actuate(&zero);
+        let offset = (splitmix64(seed) % 64) * (self.steps_per_action / 2).max(1);
+        self.solver.advance(offset).map_err(backend)?;
+        self.t0 = self.solver.time();
+        self.actions_taken = 0;
+        self.live = true;
+        let mut info = Info::default();
+        info.set("t", 0.0);
+        info.set("phase_steps", offset as f64);
+        Ok((self.observation()?, info))
+    }
+
+    fn step(&mut self, action: &[f64]) -> Result<StepResult, EnvError> {
+        if !self.live {
+            return Err(EnvError::NeedsReset);
+        }
+        let dim = self.spec.act_dim();
+        if action.len() != dim {
+            return Err(EnvError::ActionShape {
+                expected: dim,
+                got: action.len(),
+            });
+        }
+        if let Some((index, value)) = action.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(EnvError::NonFiniteAction { index, value: *value });
+        }
+        let mut a = action.to_vec();
+        let clipped = self.action_space().clip(&mut a);
+        let bound = self.bound();
+        let a_new: Vec<f64> = a.iter().map(|v| v * bound).collect();
+        let n_bodies = self.spec.bodies.len();
+        let mut cd = vec![0.0; n_bodies];
+        let mut cl = vec![0.0; n_bodies];
+        let n = self.steps_per_action;
+        let scale = 0.5 * self.units.u_lattice * self.units.u_lattice * self.units.cells_per_length;
+        let mut diverged = None;
+        let mut now = self.a_old.clone();
+        for s in 0..n {
+            let tau = (s + 1) as f64 / n as f64;
+            for (k, v) in now.iter_mut().enumerate() {
+                *v = self.spec.ramp.blend(self.a_old[k], a_new[k], tau);
+            }
+            self.actuate(&now);
+            if let Err(e) = self.solver.step() {
+                diverged = Some(e.to_string());
+                break;
+            }
+            for (b, f) in self.solver.body_forces().iter().enumerate() {
+                cd[b] += f[0] / scale / n as f64;
+                cl[b] += f[1] / scale / n as f64;
+            }
+        }
+        self.a_old = a_new.clone();
+        self.actions_taken += 1;
+        let mut info = Info::default();
+        info.set("t", self.time());
+        info.set("clipped", clipped as f64);
+        for (k, v) in a_new.iter().enumerate() {
+            info.set(&format!("actuation_{k}"), *v);
+        }
+        for b in 0..n_bodies {
+            info.set(&format!("C_D_{b}"), cd[b]);
+            info.set(&format!("C_L_{b}"), cl[b]);
+        }
+        info.set("C_D", cd.iter().sum());
+        info.set("C_L", cl.iter().sum());
+        if let Some(reason) = diverged {
+            self.live = false;
+            info.set("diverged", 1.0);
+            info.set_text("reason", reason);
+            let obs = vec![0.0; self.spec.obs_dim()];
+            return Ok(StepResult {
+                obs,
+                reward: 0.0,
+                terminated: true,
+                truncated: false,
+                info,
+            });
+        }
+        let reward = reward(&self.spec.reward, &info, n_bodies);
+        let truncated = self.actions_taken >= self.spec.episode_actions;
+        if truncated {
+            self.live = false;
+        }
+        Ok(StepResult {
+            obs: self.observation()?,
+            reward,
+            terminated: false,
+            truncated,
+            info,
+        })
+    }
+}
+
+/// The reward from the force coefficients in `info` (so it can be recomputed from `info` alone).
+pub fn reward(spec: &RewardSpec, info: &Info, n_bodies: usize) -> f64 {
+    match spec {
+        RewardSpec::DragLift { lift_weight } => {
+            let mut r = 0.0;
+            for b in 0..n_bodies {
+                r -= info.get(&format!("C_D_{b}")).unwrap_or(0.0).abs();
+                r -= lift_weight * info.get(&format!("C_L_{b}")).unwrap_or(0.0).abs();
+            }
+            r
+        }
+    }
+}
