@@ -40,6 +40,67 @@ enum Command {
     /// Measure solver speed against the machine's limits.
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// List environments, print a spec, or calibrate observation statistics.
+    ///
+    /// `hgym envs` prints a table of every ID; `hgym envs show ID` prints its full spec as TOML;
+    /// `hgym envs calibrate ID` runs it uncontrolled and records observation means and scales in
+    /// benchmarks/envs/normalization.toml (rebuild to embed them).
+    Envs(EnvsArgs),
+    /// Run one episode of a fixed policy on an environment and write metrics, plots and a
+    /// manifest (`<out>/<ID>-<policy>-seed<S>/`).
+    Run(RunArgs),
+}
+
+#[derive(Args)]
+struct EnvsArgs {
+    #[command(subcommand)]
+    command: Option<EnvsCommand>,
+    /// Print the table as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Subcommand)]
+enum EnvsCommand {
+    /// Print the full spec of an ID as TOML.
+    Show { id: String },
+    /// Compute observation statistics from an uncontrolled run and record them.
+    Calibrate {
+        id: String,
+        #[arg(long, value_enum, default_value_t = Level::Default)]
+        level: Level,
+        /// Control intervals to average over.
+        #[arg(long, default_value_t = 100)]
+        actions: usize,
+        /// The table to update.
+        #[arg(long, default_value = "benchmarks/envs/normalization.toml")]
+        table: PathBuf,
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+}
+
+#[derive(Args)]
+struct RunArgs {
+    /// Environment ID (`hgym envs` lists them), e.g. Cylinder_2D_Re100.
+    #[arg(long)]
+    env: String,
+    /// Open-loop policy.
+    #[arg(long, value_enum, default_value = "zero")]
+    policy: hgym::env::rollout::Policy,
+    /// Number of actions (control intervals).
+    #[arg(long, default_value_t = 200)]
+    steps: usize,
+    /// Resolution level.
+    #[arg(long = "res", value_enum, default_value_t = Level::Default)]
+    level: Level,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Parent folder of the result folder.
+    #[arg(long, default_value = "results/runs")]
+    out: PathBuf,
+    #[arg(long)]
+    threads: Option<usize>,
 }
 
 #[derive(Args)]
@@ -108,15 +169,19 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Validate(args) => run_validate(args),
         Command::Bench(BenchCommand::Lbm { json, quick, collision }) => run_bench(json, quick, collision),
+        Command::Envs(args) => run_envs(args),
+        Command::Run(args) => run_rollout(args),
     };
     match result {
         Ok(Outcome::Ok) => ExitCode::SUCCESS,
         Ok(Outcome::CheckFailed) => ExitCode::from(1),
         Err(e) => {
             eprintln!("error: {e:#}");
-            let bad_input = e
-                .chain()
-                .any(|c| c.downcast_ref::<ValidateError>().is_some_and(|v| v.is_bad_input()) || c.downcast_ref::<UsageError>().is_some());
+            let bad_input = e.chain().any(|c| {
+                c.downcast_ref::<ValidateError>().is_some_and(|v| v.is_bad_input())
+                    || c.downcast_ref::<UsageError>().is_some()
+                    || c.downcast_ref::<hgym::env::EnvInputError>().is_some()
+            });
             ExitCode::from(if bad_input { 2 } else { 1 })
         }
     }
@@ -229,4 +294,106 @@ fn run_bench(json: bool, quick: bool, collision: CollisionArg) -> Result<Outcome
         print!("{}", report.table());
     }
     Ok(if report.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
+}
+
+fn run_envs(args: EnvsArgs) -> Result<Outcome> {
+    match args.command {
+        None => {
+            let specs = hgym::env::registry::all();
+            if args.json {
+                let rows: Vec<serde_json::Value> = specs
+                    .iter()
+                    .map(|s| {
+                        serde_json::json!({
+                            "id": s.id, "family": s.family, "dimension": 2, "reynolds": s.reynolds,
+                            "observations": s.obs_dim(), "actions": s.act_dim(), "solver": "lbm-d2q9",
+                            "calibrated": !s.normalization.mean.is_empty(), "spec_hash": s.hash(),
+                        })
+                    })
+                    .collect();
+                println!("{}", serde_json::to_string_pretty(&rows)?);
+            } else {
+                println!("{:<26} {:>3} {:>7} {:>5} {:>5} {:<10} {:<10} {}", "ID", "dim", "Re", "obs", "act", "solver", "calibrated", "validation");
+                for s in &specs {
+                    let validation = if s.family == "cylinder" || s.family == "rotary_cylinder" {
+                        if s.reynolds <= 200.0 { "cylinder (pass)" } else { "-" }
+                    } else {
+                        "-"
+                    };
+                    println!(
+                        "{:<26} {:>3} {:>7} {:>5} {:>5} {:<10} {:<10} {}",
+                        s.id,
+                        "2D",
+                        s.reynolds,
+                        s.obs_dim(),
+                        s.act_dim(),
+                        "lbm-d2q9",
+                        if s.normalization.mean.is_empty() { "no" } else { "yes" },
+                        validation
+                    );
+                }
+            }
+            Ok(Outcome::Ok)
+        }
+        Some(EnvsCommand::Show { id }) => {
+            let spec = hgym::env::spec(&id)?;
+            println!("# {} (spec hash {})", spec.id, spec.hash());
+            print!("{}", spec.to_toml());
+            Ok(Outcome::Ok)
+        }
+        Some(EnvsCommand::Calibrate { id, level, actions, table, threads }) => {
+            let spec = hgym::env::spec(&id)?;
+            if actions == 0 {
+                return Err(UsageError("--actions must be at least 1".into()).into());
+            }
+            let text = std::fs::read_to_string(&table).with_context(|| format!("cannot read {} (run from the repository root or pass --table)", table.display()))?;
+            let mut entries = hgym::env::calibrate::parse_table(&text).map_err(anyhow::Error::msg)?;
+            let (pool, _) = thread_pool(threads)?;
+            let pb = progress_bar(actions as u64, &id);
+            let entry = pool
+                .install(|| hgym::env::calibrate::calibrate(&spec, level, actions, hgym::env::default_cache_dir(), &mut |k, _| pb.set_position(k as u64)))
+                .with_context(|| format!("calibrating {id}"))?;
+            pb.finish_and_clear();
+            entries.insert(id.clone(), entry);
+            let header: String = text.lines().take_while(|l| l.starts_with('#')).map(|l| format!("{l}\n")).collect();
+            let body = toml::to_string_pretty(&entries).context("cannot format the table")?;
+            std::fs::write(&table, format!("{header}\n{body}")).with_context(|| format!("cannot write {}", table.display()))?;
+            println!("calibrated {id} at the {} level over {actions} actions; wrote {} (rebuild to embed)", level.name(), table.display());
+            Ok(Outcome::Ok)
+        }
+    }
+}
+
+fn run_rollout(args: RunArgs) -> Result<Outcome> {
+    let spec = hgym::env::spec(&args.env)?;
+    if args.steps == 0 {
+        return Err(UsageError("--steps must be at least 1".into()).into());
+    }
+    let (pool, _) = thread_pool(args.threads)?;
+    let out = args.out.join(format!("{}-{}-seed{}", spec.id, format!("{:?}", args.policy).to_lowercase(), args.seed));
+    let opts = hgym::env::rollout::RolloutOptions {
+        level: args.level,
+        seed: args.seed,
+        actions: args.steps,
+        policy: args.policy,
+        out: out.clone(),
+        cache: hgym::env::default_cache_dir(),
+    };
+    eprintln!("{}: first use spins the flow up to its attractor (cached afterwards)", spec.id);
+    let pb = progress_bar(args.steps as u64, &spec.id);
+    let summary = pool
+        .install(|| hgym::env::rollout::rollout(&spec, &opts, &mut |k, _| pb.set_position(k as u64)))
+        .with_context(|| format!("running {}", spec.id))?;
+    pb.finish_and_clear();
+    println!(
+        "{}: {} of {} actions, total reward {:.3}, mean C_D {:.4}{}",
+        summary.env_id,
+        summary.actions_run,
+        summary.actions_planned,
+        summary.total_reward,
+        summary.mean_c_d,
+        if summary.terminated { " (terminated: solver diverged)" } else { "" }
+    );
+    println!("  results: {}", out.display());
+    Ok(if summary.terminated { Outcome::CheckFailed } else { Outcome::Ok })
 }

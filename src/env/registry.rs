@@ -1,9 +1,10 @@
 //! Every environment ID and its spec.
 
+use super::calibrate;
 use super::cylinder;
 use super::spec::EnvSpec;
 
-/// All registered specs, in a fixed order.
+/// All registered specs, in a fixed order, with their committed observation statistics.
 pub fn all() -> Vec<EnvSpec> {
     let mut v = Vec::new();
     for re in cylinder::REYNOLDS {
@@ -11,6 +12,11 @@ pub fn all() -> Vec<EnvSpec> {
     }
     for re in cylinder::REYNOLDS {
         v.push(cylinder::rotary(re));
+    }
+    // The table is checked by a test; a broken one only means uncalibrated observations.
+    let table = calibrate::parse_table(calibrate::TABLE).unwrap_or_default();
+    for s in &mut v {
+        calibrate::attach(s, &table);
     }
     v
 }
@@ -57,5 +63,10 @@ mod tests {
         assert!(get("Cylinder_2D_Re100").is_ok());
         let err = get("Cylinder_2D_Re10").unwrap_err();
         assert_eq!(err[0], "Cylinder_2D_Re100");
+    }
+
+    #[test]
+    fn committed_normalization_table_parses() {
+        calibrate::parse_table(calibrate::TABLE).unwrap();
     }
 }

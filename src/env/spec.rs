@@ -112,6 +112,6 @@ impl EnvSpec {
     }
 
     pub fn to_toml(&self) -> String {
-        toml::to_string_pretty(self).unwrap_or_else(|e| format!("# cannot print the spec as TOML: {e}\n"))
+        toml::to_string(self).unwrap_or_else(|e| format!("# cannot print the spec as TOML: {e}\n"))
     }
 }

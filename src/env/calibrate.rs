@@ -1,0 +1,74 @@
+//! Observation statistics from an uncontrolled run (`hgym envs calibrate ID`), and the embedded
+//! table of committed statistics (`benchmarks/envs/normalization.toml`).
+
+use std::collections::BTreeMap;
+
+use hgym_agents::{Env, EnvError};
+use serde::{Deserialize, Serialize};
+
+use super::spec::{EnvSpec, Normalization};
+use super::LbmEnv;
+use crate::validate::case::Level;
+
+/// The committed table, as text (embedded at build time).
+pub const TABLE: &str = include_str!("../../benchmarks/envs/normalization.toml");
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Entry {
+    pub spec_hash: String,
+    pub level: String,
+    pub actions: usize,
+    pub mean: Vec<f64>,
+    pub scale: Vec<f64>,
+}
+
+/// Hash of the spec with its normalisation removed (what the statistics depend on).
+pub fn physics_hash(spec: &EnvSpec) -> String {
+    let mut s = spec.clone();
+    s.normalization = Normalization::default();
+    s.hash()
+}
+
+/// Parses a table; a malformed one yields an error naming the problem.
+pub fn parse_table(text: &str) -> Result<BTreeMap<String, Entry>, String> {
+    toml::from_str(text).map_err(|e| format!("benchmarks/envs/normalization.toml: {e}"))
+}
+
+/// Attaches the committed statistics to `spec` when they were computed for the same physics.
+pub fn attach(spec: &mut EnvSpec, table: &BTreeMap<String, Entry>) {
+    if let Some(e) = table.get(&spec.id) {
+        if e.spec_hash == physics_hash(spec) && e.mean.len() == spec.obs_dim() && e.scale.len() == spec.obs_dim() {
+            spec.normalization = Normalization { mean: e.mean.clone(), scale: e.scale.clone() };
+        }
+    }
+}
+
+/// Runs `actions` uncontrolled control intervals from `reset(0)` and returns mean and
+/// 3-standard-deviation scale of every raw observation (scales floored at 1e-6).
+pub fn calibrate(spec: &EnvSpec, level: Level, actions: usize, cache: Option<std::path::PathBuf>, progress: &mut dyn FnMut(usize, usize)) -> Result<Entry, EnvError> {
+    let mut raw_spec = spec.clone();
+    raw_spec.normalization = Normalization::default();
+    raw_spec.episode_actions = actions.max(1);
+    let mut env = LbmEnv::new(raw_spec, level, cache)?;
+    env.reset(0)?;
+    let dim = spec.obs_dim();
+    let (mut sum, mut sq) = (vec![0.0f64; dim], vec![0.0f64; dim]);
+    let zero = vec![0.0; spec.act_dim()];
+    for k in 0..actions {
+        let r = env.step(&zero)?;
+        if r.terminated {
+            return Err(EnvError::Backend(format!("{}: uncontrolled run diverged: {}", spec.id, r.info.text("reason").unwrap_or("?"))));
+        }
+        let raw = env.raw_observation()?;
+        for i in 0..dim {
+            sum[i] += raw[i];
+            sq[i] += raw[i] * raw[i];
+        }
+        progress(k + 1, actions);
+    }
+    let n = actions.max(1) as f64;
+    let mean: Vec<f64> = sum.iter().map(|s| s / n).collect();
+    let scale = sq.iter().zip(&mean).map(|(q, m)| 3.0 * (q / n - m * m).max(0.0).sqrt().max(1e-6 / 3.0)).collect();
+    Ok(Entry { spec_hash: physics_hash(spec), level: level.name().into(), actions, mean, scale })
+}

@@ -1,0 +1,174 @@
+//! `hgym run`: one episode of a fixed policy (zero, random, sine) on an environment, with its
+//! metrics, plots and manifest written to a result folder.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use hgym_agents::{Env, EnvError};
+use serde::{Deserialize, Serialize};
+
+use super::spec::EnvSpec;
+use super::LbmEnv;
+use crate::report::manifest::{manifest, Manifest};
+use crate::report::plots;
+use crate::validate::case::Level;
+use crate::validate::run::vorticity_field;
+
+/// Open-loop policies for smoke runs and baselines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Policy {
+    /// No actuation.
+    Zero,
+    /// Uniform in [-1, 1], from a generator seeded by the run's seed.
+    Random,
+    /// `sin(2 pi k / 20)` for action k: one period per 20 actions (about one shedding period).
+    Sine,
+}
+
+#[derive(Clone, Debug)]
+pub struct RolloutOptions {
+    pub level: Level,
+    pub seed: u64,
+    pub actions: usize,
+    pub policy: Policy,
+    pub out: PathBuf,
+    pub cache: Option<PathBuf>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Metrics {
+    pub t: Vec<f64>,
+    pub reward: Vec<f64>,
+    pub c_d: Vec<f64>,
+    pub c_l: Vec<f64>,
+    /// Physical actuation per action, one list per actuator.
+    pub actuation: Vec<Vec<f64>>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct RolloutManifest {
+    pub schema: String,
+    pub env_id: String,
+    pub spec_hash: String,
+    pub spec: EnvSpec,
+    pub level: String,
+    pub seed: u64,
+    pub policy: Policy,
+    pub actions_planned: usize,
+    pub actions_run: usize,
+    pub terminated: bool,
+    pub truncated: bool,
+    pub message: Option<String>,
+    pub total_reward: f64,
+    pub mean_c_d: f64,
+    pub manifest: Manifest,
+}
+
+/// xorshift64* (Vigna 2016) for the random policy.
+struct Rng(u64);
+
+impl Rng {
+    fn next_f64(&mut self) -> f64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        let v = self.0.wrapping_mul(0x2545_F491_4F6C_DD1D);
+        (v >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// Runs one episode (at most `actions` actions) and writes `<out>/manifest.json`,
+/// `metrics.json`, `rollout.png` and `vorticity.png`.
+pub fn rollout(spec: &EnvSpec, opts: &RolloutOptions, progress: &mut dyn FnMut(usize, usize)) -> Result<RolloutManifest, EnvError> {
+    let started = Instant::now();
+    let mut spec_run = spec.clone();
+    spec_run.episode_actions = opts.actions.max(1);
+    let mut env = LbmEnv::new(spec_run, opts.level, opts.cache.clone())?;
+    env.reset(opts.seed)?;
+    let dim = spec.act_dim();
+    let mut rng = Rng(opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    let mut m = Metrics { t: vec![], reward: vec![], c_d: vec![], c_l: vec![], actuation: vec![vec![]; dim] };
+    let (mut terminated, mut truncated, mut message) = (false, false, None);
+    for k in 0..opts.actions.max(1) {
+        let a: Vec<f64> = match opts.policy {
+            Policy::Zero => vec![0.0; dim],
+            Policy::Random => (0..dim).map(|_| 2.0 * rng.next_f64() - 1.0).collect(),
+            Policy::Sine => vec![(2.0 * std::f64::consts::PI * k as f64 / 20.0).sin(); dim],
+        };
+        let r = env.step(&a)?;
+        m.t.push(r.info.get("t").unwrap_or(0.0));
+        m.reward.push(r.reward);
+        m.c_d.push(r.info.get("C_D").unwrap_or(f64::NAN));
+        m.c_l.push(r.info.get("C_L").unwrap_or(f64::NAN));
+        for (j, col) in m.actuation.iter_mut().enumerate() {
+            col.push(r.info.get(&format!("actuation_{j}")).unwrap_or(0.0));
+        }
+        progress(k + 1, opts.actions);
+        if r.terminated {
+            terminated = true;
+            message = r.info.text("reason").map(|s| s.to_string());
+            break;
+        }
+        if r.truncated {
+            truncated = true;
+            break;
+        }
+    }
+    let n = m.reward.len();
+    let summary = RolloutManifest {
+        schema: "hgym/rollout/v1".into(),
+        env_id: spec.id.clone(),
+        spec_hash: spec.hash(),
+        spec: spec.clone(),
+        level: opts.level.name().into(),
+        seed: opts.seed,
+        policy: opts.policy,
+        actions_planned: opts.actions,
+        actions_run: n,
+        terminated,
+        truncated,
+        message,
+        total_reward: m.reward.iter().sum(),
+        mean_c_d: m.c_d.iter().filter(|v| v.is_finite()).sum::<f64>() / n.max(1) as f64,
+        manifest: manifest(rayon::current_num_threads(), started.elapsed().as_secs_f64()),
+    };
+    write(&opts.out, &summary, &m, &env).map_err(EnvError::Backend)?;
+    Ok(summary)
+}
+
+fn write(dir: &Path, summary: &RolloutManifest, m: &Metrics, env: &LbmEnv) -> Result<(), String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let put = |name: &str, text: String| std::fs::write(dir.join(name), text + "\n").map_err(|e| format!("cannot write {}: {e}", dir.join(name).display()));
+    put("manifest.json", serde_json::to_string_pretty(summary).map_err(|e| e.to_string())?)?;
+    put("metrics.json", serde_json::to_string_pretty(m).map_err(|e| e.to_string())?)?;
+    let mut panels = vec![
+        plots::Series { label: "reward", values: &m.reward },
+        plots::Series { label: "C_D", values: &m.c_d },
+        plots::Series { label: "C_L", values: &m.c_l },
+    ];
+    let labels: Vec<String> = (0..m.actuation.len()).map(|j| format!("actuation {j}")).collect();
+    for (j, col) in m.actuation.iter().enumerate() {
+        panels.push(plots::Series { label: &labels[j], values: col });
+    }
+    let title = format!("{} ({}, {:?} policy, seed {})", summary.env_id, summary.level, summary.policy, summary.seed);
+    plots::time_series(&dir.join("rollout.png"), &title, &m.t, &panels, None)?;
+    let d = &summary.spec.domain;
+    let units = hgym_solvers::lbm::Units {
+        cells_per_length: summary.spec.cells_per_length(env_level(&summary.level)) as f64,
+        u_lattice: summary.spec.lattice_velocity,
+        reynolds: summary.spec.reynolds,
+    };
+    let v = vorticity_field(env.solver(), &units, [d.x[0], d.x[1], d.y[0], d.y[1]]);
+    let vmax = plots::abs_quantile(&v.values, 0.99);
+    plots::field(&dir.join("vorticity.png"), &format!("{}: vorticity w L/U at the end", summary.env_id), v.nx, v.ny, v.extent, &v.values, vmax)?;
+    Ok(())
+}
+
+fn env_level(name: &str) -> Level {
+    match name {
+        "coarse" => Level::Coarse,
+        "fine" => Level::Fine,
+        _ => Level::Default,
+    }
+}
