@@ -143,6 +143,18 @@ enum BenchCommand {
         #[arg(long, value_enum, default_value = "regularized")]
         collision: CollisionArg,
     },
+    /// Control steps (actions) per second of each environment family at coarse and default.
+    Envs {
+        /// Print the rows as JSON.
+        #[arg(long)]
+        json: bool,
+        /// Actions timed per family and level.
+        #[arg(long, default_value_t = 20)]
+        actions: usize,
+        /// Only the coarse level (fast smoke run).
+        #[arg(long)]
+        quick: bool,
+    },
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -169,6 +181,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Validate(args) => run_validate(args),
         Command::Bench(BenchCommand::Lbm { json, quick, collision }) => run_bench(json, quick, collision),
+        Command::Bench(BenchCommand::Envs { json, actions, quick }) => run_bench_envs(json, actions, quick),
         Command::Envs(args) => run_envs(args),
         Command::Run(args) => run_rollout(args),
     };
@@ -313,10 +326,17 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
                     .collect();
                 println!("{}", serde_json::to_string_pretty(&rows)?);
             } else {
-                println!("{:<26} {:>3} {:>7} {:>5} {:>5} {:<10} {:<10} {}", "ID", "dim", "Re", "obs", "act", "solver", "calibrated", "validation");
+                println!(
+                    "{:<26} {:>3} {:>7} {:>5} {:>5} {:<10} {:<10} {}",
+                    "ID", "dim", "Re", "obs", "act", "solver", "calibrated", "validation"
+                );
                 for s in &specs {
                     let validation = if s.family == "cylinder" || s.family == "rotary_cylinder" {
-                        if s.reynolds <= 200.0 { "cylinder (pass)" } else { "-" }
+                        if s.reynolds <= 200.0 {
+                            "cylinder (pass)"
+                        } else {
+                            "-"
+                        }
                     } else {
                         "-"
                     };
@@ -341,24 +361,39 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
             print!("{}", spec.to_toml());
             Ok(Outcome::Ok)
         }
-        Some(EnvsCommand::Calibrate { id, level, actions, table, threads }) => {
+        Some(EnvsCommand::Calibrate {
+            id,
+            level,
+            actions,
+            table,
+            threads,
+        }) => {
             let spec = hgym::env::spec(&id)?;
             if actions == 0 {
                 return Err(UsageError("--actions must be at least 1".into()).into());
             }
-            let text = std::fs::read_to_string(&table).with_context(|| format!("cannot read {} (run from the repository root or pass --table)", table.display()))?;
+            let text = std::fs::read_to_string(&table)
+                .with_context(|| format!("cannot read {} (run from the repository root or pass --table)", table.display()))?;
             let mut entries = hgym::env::calibrate::parse_table(&text).map_err(anyhow::Error::msg)?;
             let (pool, _) = thread_pool(threads)?;
             let pb = progress_bar(actions as u64, &id);
             let entry = pool
-                .install(|| hgym::env::calibrate::calibrate(&spec, level, actions, hgym::env::default_cache_dir(), &mut |k, _| pb.set_position(k as u64)))
+                .install(|| {
+                    hgym::env::calibrate::calibrate(&spec, level, actions, hgym::env::default_cache_dir(), &mut |k, _| {
+                        pb.set_position(k as u64)
+                    })
+                })
                 .with_context(|| format!("calibrating {id}"))?;
             pb.finish_and_clear();
             entries.insert(id.clone(), entry);
             let header: String = text.lines().take_while(|l| l.starts_with('#')).map(|l| format!("{l}\n")).collect();
             let body = toml::to_string_pretty(&entries).context("cannot format the table")?;
             std::fs::write(&table, format!("{header}\n{body}")).with_context(|| format!("cannot write {}", table.display()))?;
-            println!("calibrated {id} at the {} level over {actions} actions; wrote {} (rebuild to embed)", level.name(), table.display());
+            println!(
+                "calibrated {id} at the {} level over {actions} actions; wrote {} (rebuild to embed)",
+                level.name(),
+                table.display()
+            );
             Ok(Outcome::Ok)
         }
     }
@@ -370,7 +405,12 @@ fn run_rollout(args: RunArgs) -> Result<Outcome> {
         return Err(UsageError("--steps must be at least 1".into()).into());
     }
     let (pool, _) = thread_pool(args.threads)?;
-    let out = args.out.join(format!("{}-{}-seed{}", spec.id, format!("{:?}", args.policy).to_lowercase(), args.seed));
+    let out = args.out.join(format!(
+        "{}-{}-seed{}",
+        spec.id,
+        format!("{:?}", args.policy).to_lowercase(),
+        args.seed
+    ));
     let opts = hgym::env::rollout::RolloutOptions {
         level: args.level,
         seed: args.seed,
@@ -396,4 +436,28 @@ fn run_rollout(args: RunArgs) -> Result<Outcome> {
     );
     println!("  results: {}", out.display());
     Ok(if summary.terminated { Outcome::CheckFailed } else { Outcome::Ok })
+}
+
+fn run_bench_envs(json: bool, actions: usize, quick: bool) -> Result<Outcome> {
+    if actions == 0 {
+        return Err(UsageError("--actions must be at least 1".into()).into());
+    }
+    let levels: &[Level] = if quick {
+        &[Level::Coarse]
+    } else {
+        &[Level::Coarse, Level::Default]
+    };
+    let rows = hgym::bench::envs::bench_envs(levels, actions, hgym::env::default_cache_dir(), &mut |m| {
+        if !json {
+            eprintln!("{m}");
+        }
+    })
+    .map_err(anyhow::Error::msg)
+    .context("environment benchmark")?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        print!("{}", hgym::bench::envs::table(&rows));
+    }
+    Ok(Outcome::Ok)
 }

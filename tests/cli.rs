@@ -279,3 +279,70 @@ fn bench_quick_reports_mlups_and_roofline_fraction() {
     }
     assert_eq!(v["bytes_per_cell"], 72);
 }
+
+#[test]
+fn envs_lists_every_id_and_show_round_trips() {
+    let o = hgym(&["envs"]);
+    assert!(o.status.success());
+    let (out, _) = text(&o);
+    for spec in hgym::env::registry::all() {
+        assert!(out.contains(&spec.id), "{} missing from `hgym envs`", spec.id);
+    }
+    let o = hgym(&["envs", "show", "Cylinder_2D_Re200"]);
+    assert!(o.status.success());
+    let shown: hgym::env::EnvSpec = toml::from_str(&text(&o).0).expect("`envs show` prints valid TOML");
+    assert_eq!(shown, hgym::env::registry::get("Cylinder_2D_Re200").unwrap());
+}
+
+#[test]
+fn unknown_env_id_exits_2_with_suggestions() {
+    for args in [
+        vec!["envs", "show", "Cylinder_2D_Re10"],
+        vec!["run", "--env", "Cylinder_2D_Re10", "--steps", "1"],
+    ] {
+        let o = hgym(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let (_, err) = text(&o);
+        assert!(
+            err.contains("unknown environment ID 'Cylinder_2D_Re10'") && err.contains("Cylinder_2D_Re100"),
+            "{err}"
+        );
+    }
+}
+
+#[test]
+fn run_writes_metrics_plots_and_manifest() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("runs");
+    let o = Command::new(env!("CARGO_BIN_EXE_hgym"))
+        .args([
+            "run",
+            "--env",
+            "RotaryCylinder_2D_Re100",
+            "--policy",
+            "random",
+            "--steps",
+            "5",
+            "--res",
+            "coarse",
+            "--seed",
+            "3",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .env("HGYM_CACHE", dir.path().join("cache"))
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stdout}\n{stderr}");
+    let folder = out.join("RotaryCylinder_2D_Re100-random-seed3");
+    for f in ["manifest.json", "metrics.json", "rollout.png", "vorticity.png"] {
+        assert!(folder.join(f).exists(), "{f} missing");
+    }
+    let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(folder.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(m["actions_run"], 5);
+    assert_eq!(m["truncated"], true);
+    assert_eq!(m["spec_hash"].as_str().unwrap().len(), 64);
+    // The developed flow was cached for the next run.
+    assert!(std::fs::read_dir(dir.path().join("cache")).unwrap().count() >= 1);
+}

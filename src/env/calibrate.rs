@@ -39,14 +39,23 @@ pub fn parse_table(text: &str) -> Result<BTreeMap<String, Entry>, String> {
 pub fn attach(spec: &mut EnvSpec, table: &BTreeMap<String, Entry>) {
     if let Some(e) = table.get(&spec.id) {
         if e.spec_hash == physics_hash(spec) && e.mean.len() == spec.obs_dim() && e.scale.len() == spec.obs_dim() {
-            spec.normalization = Normalization { mean: e.mean.clone(), scale: e.scale.clone() };
+            spec.normalization = Normalization {
+                mean: e.mean.clone(),
+                scale: e.scale.clone(),
+            };
         }
     }
 }
 
 /// Runs `actions` uncontrolled control intervals from `reset(0)` and returns mean and
 /// 3-standard-deviation scale of every raw observation (scales floored at 1e-6).
-pub fn calibrate(spec: &EnvSpec, level: Level, actions: usize, cache: Option<std::path::PathBuf>, progress: &mut dyn FnMut(usize, usize)) -> Result<Entry, EnvError> {
+pub fn calibrate(
+    spec: &EnvSpec,
+    level: Level,
+    actions: usize,
+    cache: Option<std::path::PathBuf>,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Entry, EnvError> {
     let mut raw_spec = spec.clone();
     raw_spec.normalization = Normalization::default();
     raw_spec.episode_actions = actions.max(1);
@@ -58,7 +67,11 @@ pub fn calibrate(spec: &EnvSpec, level: Level, actions: usize, cache: Option<std
     for k in 0..actions {
         let r = env.step(&zero)?;
         if r.terminated {
-            return Err(EnvError::Backend(format!("{}: uncontrolled run diverged: {}", spec.id, r.info.text("reason").unwrap_or("?"))));
+            return Err(EnvError::Backend(format!(
+                "{}: uncontrolled run diverged: {}",
+                spec.id,
+                r.info.text("reason").unwrap_or("?")
+            )));
         }
         let raw = env.raw_observation()?;
         for i in 0..dim {
@@ -69,6 +82,16 @@ pub fn calibrate(spec: &EnvSpec, level: Level, actions: usize, cache: Option<std
     }
     let n = actions.max(1) as f64;
     let mean: Vec<f64> = sum.iter().map(|s| s / n).collect();
-    let scale = sq.iter().zip(&mean).map(|(q, m)| 3.0 * (q / n - m * m).max(0.0).sqrt().max(1e-6 / 3.0)).collect();
-    Ok(Entry { spec_hash: physics_hash(spec), level: level.name().into(), actions, mean, scale })
+    let scale = sq
+        .iter()
+        .zip(&mean)
+        .map(|(q, m)| 3.0 * (q / n - m * m).max(0.0).sqrt().max(1e-6 / 3.0))
+        .collect();
+    Ok(Entry {
+        spec_hash: physics_hash(spec),
+        level: level.name().into(),
+        actions,
+        mean,
+        scale,
+    })
 }

@@ -25,7 +25,10 @@ pub enum EnvInputError {
 
 /// The spec of `id`, or an error that names the closest IDs.
 pub fn spec(id: &str) -> Result<EnvSpec, EnvInputError> {
-    registry::get(id).map_err(|closest| EnvInputError::UnknownEnv { id: id.to_string(), closest })
+    registry::get(id).map_err(|closest| EnvInputError::UnknownEnv {
+        id: id.to_string(),
+        closest,
+    })
 }
 
 /// Where developed-flow states are cached: `$HGYM_CACHE`, else `~/.cache/hgym/states`.

@@ -88,7 +88,13 @@ pub fn rollout(spec: &EnvSpec, opts: &RolloutOptions, progress: &mut dyn FnMut(u
     env.reset(opts.seed)?;
     let dim = spec.act_dim();
     let mut rng = Rng(opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
-    let mut m = Metrics { t: vec![], reward: vec![], c_d: vec![], c_l: vec![], actuation: vec![vec![]; dim] };
+    let mut m = Metrics {
+        t: vec![],
+        reward: vec![],
+        c_d: vec![],
+        c_l: vec![],
+        actuation: vec![vec![]; dim],
+    };
     let (mut terminated, mut truncated, mut message) = (false, false, None);
     for k in 0..opts.actions.max(1) {
         let a: Vec<f64> = match opts.policy {
@@ -139,19 +145,36 @@ pub fn rollout(spec: &EnvSpec, opts: &RolloutOptions, progress: &mut dyn FnMut(u
 
 fn write(dir: &Path, summary: &RolloutManifest, m: &Metrics, env: &LbmEnv) -> Result<(), String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    let put = |name: &str, text: String| std::fs::write(dir.join(name), text + "\n").map_err(|e| format!("cannot write {}: {e}", dir.join(name).display()));
+    let put = |name: &str, text: String| {
+        std::fs::write(dir.join(name), text + "\n").map_err(|e| format!("cannot write {}: {e}", dir.join(name).display()))
+    };
     put("manifest.json", serde_json::to_string_pretty(summary).map_err(|e| e.to_string())?)?;
     put("metrics.json", serde_json::to_string_pretty(m).map_err(|e| e.to_string())?)?;
     let mut panels = vec![
-        plots::Series { label: "reward", values: &m.reward },
-        plots::Series { label: "C_D", values: &m.c_d },
-        plots::Series { label: "C_L", values: &m.c_l },
+        plots::Series {
+            label: "reward",
+            values: &m.reward,
+        },
+        plots::Series {
+            label: "C_D",
+            values: &m.c_d,
+        },
+        plots::Series {
+            label: "C_L",
+            values: &m.c_l,
+        },
     ];
     let labels: Vec<String> = (0..m.actuation.len()).map(|j| format!("actuation {j}")).collect();
     for (j, col) in m.actuation.iter().enumerate() {
-        panels.push(plots::Series { label: &labels[j], values: col });
+        panels.push(plots::Series {
+            label: &labels[j],
+            values: col,
+        });
     }
-    let title = format!("{} ({}, {:?} policy, seed {})", summary.env_id, summary.level, summary.policy, summary.seed);
+    let title = format!(
+        "{} ({}, {:?} policy, seed {})",
+        summary.env_id, summary.level, summary.policy, summary.seed
+    );
     plots::time_series(&dir.join("rollout.png"), &title, &m.t, &panels, None)?;
     let d = &summary.spec.domain;
     let units = hgym_solvers::lbm::Units {
@@ -161,7 +184,15 @@ fn write(dir: &Path, summary: &RolloutManifest, m: &Metrics, env: &LbmEnv) -> Re
     };
     let v = vorticity_field(env.solver(), &units, [d.x[0], d.x[1], d.y[0], d.y[1]]);
     let vmax = plots::abs_quantile(&v.values, 0.99);
-    plots::field(&dir.join("vorticity.png"), &format!("{}: vorticity w L/U at the end", summary.env_id), v.nx, v.ny, v.extent, &v.values, vmax)?;
+    plots::field(
+        &dir.join("vorticity.png"),
+        &format!("{}: vorticity w L/U at the end", summary.env_id),
+        v.nx,
+        v.ny,
+        v.extent,
+        &v.values,
+        vmax,
+    )?;
     Ok(())
 }
 
