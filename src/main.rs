@@ -327,8 +327,8 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
                 println!("{}", serde_json::to_string_pretty(&rows)?);
             } else {
                 println!(
-                    "{:<26} {:>3} {:>7} {:>5} {:>5} {:<10} {:<10} {}",
-                    "ID", "dim", "Re", "obs", "act", "solver", "calibrated", "validation"
+                    "{:<26} {:>3} {:>7} {:>5} {:>5} {:<10} {:<10} validation",
+                    "ID", "dim", "Re", "obs", "act", "solver", "calibrated"
                 );
                 for s in &specs {
                     let validation = if s.family == "cylinder" || s.family == "rotary_cylinder" {
