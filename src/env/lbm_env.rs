@@ -198,9 +198,12 @@ impl LbmEnv {
                 }
             }
         }
-        // Spin up from the uniform flow with a transverse kick behind the first body.
+        // Spin up from the uniform flow with a transverse kick just behind the last body.
         let u = self.spec.lattice_velocity;
-        let c = self.spec.bodies.first().map(|b| b.center()).unwrap_or([0.0, 0.0]);
+        let centers: Vec<[f64; 2]> = self.spec.bodies.iter().map(|b| b.center()).collect();
+        let x_back = centers.iter().map(|c| c[0]).fold(f64::NEG_INFINITY, f64::max);
+        let y_mid = centers.iter().map(|c| c[1]).sum::<f64>() / centers.len().max(1) as f64;
+        let c = if centers.is_empty() { [0.0, 0.0] } else { [x_back, y_mid] };
         self.solver.init_with(|x, y| {
             let r2 = (x - c[0] - 1.0).powi(2) + (y - c[1] - 0.25).powi(2);
             (1.0, u, 0.3 * u * (-4.0 * r2).exp())

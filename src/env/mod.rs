@@ -1,7 +1,7 @@
 //! Flow environments: where solvers (`hgym-solvers`) meet the `Env` contract (`hgym-agents`).
 //!
 //! - [`spec`]: the serialisable description of an environment (its hash keys caches and results);
-//! - [`registry`]: every ID; [`cylinder`]: the cylinder family's specs;
+//! - [`registry`]: every ID; [`cylinder`], [`pinball`]: the families' specs;
 //! - [`lbm_env`]: the `Env` implementation for 2D lattice-Boltzmann families;
 //! - [`actuation`]: jets, rotation, and the temporal smoothing of actions.
 
@@ -9,6 +9,7 @@ pub mod actuation;
 pub mod calibrate;
 pub mod cylinder;
 pub mod lbm_env;
+pub mod pinball;
 pub mod registry;
 pub mod rollout;
 pub mod spec;

@@ -2,6 +2,7 @@
 
 use super::calibrate;
 use super::cylinder;
+use super::pinball;
 use super::spec::EnvSpec;
 
 /// All registered specs, in a fixed order, with their committed observation statistics.
@@ -12,6 +13,9 @@ pub fn all() -> Vec<EnvSpec> {
     }
     for re in cylinder::REYNOLDS {
         v.push(cylinder::rotary(re));
+    }
+    for re in pinball::REYNOLDS {
+        v.push(pinball::rotary(re));
     }
     // The table is checked by a test; a broken one only means uncalibrated observations.
     let table = calibrate::parse_table(calibrate::TABLE).unwrap_or_default();
