@@ -24,6 +24,9 @@ pub const BUNDLED: &[(&str, &str)] = &[
         "cylinder_re200.toml",
         include_str!("../../benchmarks/validation/cylinder_re200.toml"),
     ),
+    ("pinball_re30.toml", include_str!("../../benchmarks/validation/pinball_re30.toml")),
+    ("pinball_re100.toml", include_str!("../../benchmarks/validation/pinball_re100.toml")),
+    ("pinball_re150.toml", include_str!("../../benchmarks/validation/pinball_re150.toml")),
 ];
 
 /// Largest lattice speed anywhere on the inlet (Mach 0.3 = 0.173 lattice units): above it the
@@ -36,7 +39,12 @@ pub const MAX_NODES: usize = 50_000_000;
 #[serde(deny_unknown_fields)]
 pub struct Case {
     pub case: CaseInfo,
+    /// The reference body (its length is L; it is body 1 in per-body quantities).
     pub geometry: GeometrySpec,
+    /// Further bodies (`[[more_bodies]]`, same keys as `[geometry]`): bodies 2, 3, ... Drag and
+    /// lift quantities are totals over all bodies; `mean_cl_2`, `mean_cl_3` are per body.
+    #[serde(default)]
+    pub more_bodies: Vec<GeometrySpec>,
     pub domain: DomainSpec,
     pub boundaries: BoundarySpec,
     #[serde(default)]
@@ -198,6 +206,13 @@ pub enum Quantity {
     ClAmplitude,
     ClRms,
     CdAmplitude,
+    /// Mean lift of body 1, 2, 3 (1 = `[geometry]`, then `[[more_bodies]]` in order).
+    #[serde(rename = "mean_cl_1")]
+    MeanCl1,
+    #[serde(rename = "mean_cl_2")]
+    MeanCl2,
+    #[serde(rename = "mean_cl_3")]
+    MeanCl3,
 }
 
 impl Quantity {
@@ -209,6 +224,19 @@ impl Quantity {
             Quantity::ClAmplitude => "cl_amplitude",
             Quantity::ClRms => "cl_rms",
             Quantity::CdAmplitude => "cd_amplitude",
+            Quantity::MeanCl1 => "mean_cl_1",
+            Quantity::MeanCl2 => "mean_cl_2",
+            Quantity::MeanCl3 => "mean_cl_3",
+        }
+    }
+
+    /// The body (0-based) of a per-body quantity.
+    pub fn body(self) -> Option<usize> {
+        match self {
+            Quantity::MeanCl1 => Some(0),
+            Quantity::MeanCl2 => Some(1),
+            Quantity::MeanCl3 => Some(2),
+            _ => None,
         }
     }
 }
@@ -407,20 +435,38 @@ impl LoadedCase {
                 }
             }
         }
-        // Body inside the domain, at least two cells from every edge even at the coarse level.
+        for q in &c.measure.quantities {
+            if let Some(b) = q.body() {
+                if b > c.more_bodies.len() {
+                    return Err(bad(
+                        name,
+                        "measure.quantities",
+                        format!(
+                            "'{}' needs body {}, but the case has {} bodies",
+                            q.name(),
+                            b + 1,
+                            1 + c.more_bodies.len()
+                        ),
+                    ));
+                }
+            }
+        }
+        // Bodies inside the domain, at least two cells from every edge even at the coarse level.
         let dx = l / r.coarse.min(r.default).min(r.fine) as f64;
-        let body = super::run::build_shape(&c.geometry);
-        let bb = body.bounding_box();
-        if bb[0] < d.x[0] + 2.0 * dx || bb[2] > d.x[1] - 2.0 * dx || bb[1] < d.y[0] + 2.0 * dx || bb[3] > d.y[1] - 2.0 * dx {
-            return Err(bad(
-                name,
-                "geometry",
-                format!(
-                    "the body spans [{:.3}, {:.3}] x [{:.3}, {:.3}], which does not fit inside the domain [{}, {}] x [{}, {}] \
+        for g in std::iter::once(&c.geometry).chain(&c.more_bodies) {
+            let body = super::run::build_shape(g);
+            let bb = body.bounding_box();
+            if bb[0] < d.x[0] + 2.0 * dx || bb[2] > d.x[1] - 2.0 * dx || bb[1] < d.y[0] + 2.0 * dx || bb[3] > d.y[1] - 2.0 * dx {
+                return Err(bad(
+                    name,
+                    "geometry",
+                    format!(
+                        "the body spans [{:.3}, {:.3}] x [{:.3}, {:.3}], which does not fit inside the domain [{}, {}] x [{}, {}] \
                      with two cells to spare: enlarge the domain or move/shrink the body",
-                    bb[0], bb[2], bb[1], bb[3], d.x[0], d.x[1], d.y[0], d.y[1]
-                ),
-            ));
+                        bb[0], bb[2], bb[1], bb[3], d.x[0], d.x[1], d.y[0], d.y[1]
+                    ),
+                ));
+            }
         }
         Ok(())
     }

@@ -82,7 +82,24 @@ pub struct ValidationReport {
     pub manifest: Manifest,
 }
 
-fn measured(a: &Analysis, q: Quantity) -> Option<f64> {
+/// Mean of `v` over the samples with `t` in `[w0, w1)`.
+fn window_mean(t: &[f64], v: &[f64], w: [f64; 2]) -> Option<f64> {
+    let (s, n) = t
+        .iter()
+        .zip(v)
+        .filter(|(t, _)| **t >= w[0] && **t < w[1])
+        .fold((0.0, 0usize), |(s, n), (_, v)| (s + v, n + 1));
+    (n > 0).then(|| s / n as f64)
+}
+
+fn measured(a: &Analysis, q: Quantity, out: &RunOutput) -> Option<f64> {
+    if let Some(b) = q.body() {
+        return out
+            .cl_bodies
+            .get(b)
+            .and_then(|v| window_mean(&out.t, v, a.window))
+            .filter(|v| v.is_finite());
+    }
     match q {
         Quantity::Strouhal => a.strouhal,
         Quantity::MeanCd => Some(a.mean_cd),
@@ -90,6 +107,7 @@ fn measured(a: &Analysis, q: Quantity) -> Option<f64> {
         Quantity::ClAmplitude => Some(a.cl_amplitude),
         Quantity::ClRms => Some(a.cl_rms),
         Quantity::CdAmplitude => Some(a.cd_amplitude),
+        Quantity::MeanCl1 | Quantity::MeanCl2 | Quantity::MeanCl3 => None,
     }
     .filter(|v| v.is_finite())
 }
@@ -101,7 +119,7 @@ impl ValidationReport {
         let a = analyse(&out.t, &out.cd, &out.cl, case.time.spin_up);
         let mut quantities = Vec::new();
         for &q in &case.measure.quantities {
-            let m = if diverged { None } else { measured(&a, q) };
+            let m = if diverged { None } else { measured(&a, q, out) };
             let r = case.reference.iter().find(|r| r.quantity == q);
             let (reference, tolerance, kind, deviation, pass, source) = match r {
                 None => (None, None, None, None, None, None),

@@ -140,6 +140,8 @@ pub struct RunOutput {
     pub t: Vec<f64>,
     pub cd: Vec<f64>,
     pub cl: Vec<f64>,
+    /// Lift of each body (totals are `cl`).
+    pub cl_bodies: Vec<Vec<f64>>,
     pub vorticity: Field,
     pub status: RunStatus,
     pub wall_time_s: f64,
@@ -194,8 +196,9 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     cfg.smagorinsky = case.flow.smagorinsky;
     cfg.grid = grid;
     cfg.check_interval = 200;
-    let body = build_shape(&case.geometry);
-    let mut solver = D2q9::new(cfg, vec![body]).map_err(|e| match e {
+    let bodies: Vec<_> = std::iter::once(&case.geometry).chain(&case.more_bodies).map(build_shape).collect();
+    let n_bodies = bodies.len();
+    let mut solver = D2q9::new(cfg, bodies).map_err(|e| match e {
         LbmError::Config { field, message } => ValidateError::Unrunnable {
             case: case.case.name.clone(),
             field: field.to_string(),
@@ -219,6 +222,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     let mut t = Vec::with_capacity(total as usize);
     let mut cd = Vec::with_capacity(total as usize);
     let mut cl = Vec::with_capacity(total as usize);
+    let mut cl_bodies = vec![Vec::with_capacity(total as usize); n_bodies];
     let coef = 0.5 * u * u * n;
     let started = Instant::now();
     let mut status = RunStatus::Completed;
@@ -244,10 +248,13 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
             };
             break;
         }
-        let f = solver.body_forces()[0];
+        let forces = solver.body_forces();
         t.push((s + 1) as f64 / steps_per_time);
-        cd.push(f[0] / coef);
-        cl.push(f[1] / coef);
+        cd.push(forces.iter().map(|f| f[0]).sum::<f64>() / coef);
+        cl.push(forces.iter().map(|f| f[1]).sum::<f64>() / coef);
+        for (b, f) in forces.iter().enumerate() {
+            cl_bodies[b].push(f[1] / coef);
+        }
         if (s + 1) % report_every == 0 {
             progress(s + 1, total);
         }
@@ -262,6 +269,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
         t,
         cd,
         cl,
+        cl_bodies,
         vorticity,
         status,
         wall_time_s: wall,
