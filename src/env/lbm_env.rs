@@ -16,12 +16,12 @@
 use std::path::PathBuf;
 
 use hgym_agents::{BoxSpace, Env, EnvError, Info, StepResult};
-use hgym_solvers::lbm::{D2q9, D2q9Config, Grid, Side, Sides, Units};
+use hgym_solvers::lbm::{D2q9, D2q9Config, Grid, Units};
 
 use super::actuation::{apply, Jet, WallMotion};
 use super::spec::{ActuationSpec, EnvSpec, RewardSpec};
-use crate::validate::case::{BoundaryKind, GeometrySpec, Level};
-use crate::validate::run::build_shape;
+use crate::validate::case::{GeometrySpec, Level};
+use crate::validate::run::{build_shape, sides_of};
 
 /// splitmix64 (Steele, Lea & Flood 2014): a seed -> a well-mixed 64-bit value.
 fn splitmix64(seed: u64) -> u64 {
@@ -69,22 +69,7 @@ impl LbmEnv {
             dx,
         };
         let u = spec.lattice_velocity as f32;
-        let side = |k: BoundaryKind| match k {
-            BoundaryKind::Inlet => Side::Velocity {
-                profile: vec![[u, 0.0]; ny],
-            },
-            BoundaryKind::Outlet => Side::Outlet,
-            BoundaryKind::Periodic => Side::Periodic,
-            BoundaryKind::Wall => Side::Wall,
-            BoundaryKind::FreeSlip => Side::FreeSlip,
-        };
-        let b = &spec.boundaries;
-        let sides = Sides {
-            west: side(b.west),
-            east: side(b.east),
-            south: side(b.south),
-            north: side(b.north),
-        };
+        let sides = sides_of(&spec.boundaries, &vec![[u, 0.0]; ny]);
         let mut cfg = D2q9Config::new(nx, ny, units.tau(), sides);
         cfg.collision = spec.collision;
         cfg.smagorinsky = spec.smagorinsky;

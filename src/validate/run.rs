@@ -7,7 +7,7 @@ use std::time::Instant;
 use hgym_solvers::geometry::{Circle, Naca4, Rectangle, Shape};
 use hgym_solvers::lbm::{Collision, D2q9, D2q9Config, Grid, LbmError, Side, Sides, Units};
 
-use super::case::{BoundaryKind, GeometrySpec, Level, LoadedCase, Profile, MAX_NODES};
+use super::case::{BoundaryKind, BoundarySpec, GeometrySpec, Level, LoadedCase, Profile, MAX_NODES};
 use super::ValidateError;
 
 /// The body of a case as a signed-distance shape.
@@ -33,6 +33,24 @@ pub fn build_shape(g: &GeometrySpec) -> Arc<dyn Shape> {
                     .unwrap_or_else(|| Naca4::new(0.0, 0.0, 0.12, *chord, *leading_edge, *aoa_deg)),
             )
         }
+    }
+}
+
+/// The solver's domain edges for a case's boundary kinds; `inlet` is the lattice velocity
+/// profile of the (west) inlet, one value per row.
+pub fn sides_of(b: &BoundarySpec, inlet: &[[f32; 2]]) -> Sides {
+    let side = |k: BoundaryKind| match k {
+        BoundaryKind::Inlet => Side::Velocity { profile: inlet.to_vec() },
+        BoundaryKind::Outlet => Side::Outlet,
+        BoundaryKind::Periodic => Side::Periodic,
+        BoundaryKind::Wall => Side::Wall,
+        BoundaryKind::FreeSlip => Side::FreeSlip,
+    };
+    Sides {
+        west: side(b.west),
+        east: side(b.east),
+        south: side(b.south),
+        north: side(b.north),
     }
 }
 
@@ -173,24 +191,8 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
             }
         }
     };
-    let side = |k: BoundaryKind| -> Side {
-        match k {
-            BoundaryKind::Inlet => Side::Velocity {
-                profile: (0..ny).map(|j| [inlet_u(grid.position(0.0, j as f64)[1]) as f32, 0.0]).collect(),
-            },
-            BoundaryKind::Outlet => Side::Outlet,
-            BoundaryKind::Periodic => Side::Periodic,
-            BoundaryKind::Wall => Side::Wall,
-            BoundaryKind::FreeSlip => Side::FreeSlip,
-        }
-    };
-    let b = &case.boundaries;
-    let sides = Sides {
-        west: side(b.west),
-        east: side(b.east),
-        south: side(b.south),
-        north: side(b.north),
-    };
+    let inlet: Vec<[f32; 2]> = (0..ny).map(|j| [inlet_u(grid.position(0.0, j as f64)[1]) as f32, 0.0]).collect();
+    let sides = sides_of(&case.boundaries, &inlet);
     let mut cfg = D2q9Config::new(nx, ny, plan.tau, sides);
     cfg.collision = plan.collision;
     cfg.smagorinsky = case.flow.smagorinsky;
