@@ -13,7 +13,7 @@
 //! benchmarks/validation/cylinder_re100.toml).
 
 use super::actuation::Ramp;
-use super::spec::{ActuationSpec, EnvSpec, Normalization, RewardSpec};
+use super::spec::{probe_grid, ActuationSpec, EnvSpec, Normalization, RewardSpec};
 use crate::validate::case::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
 
 /// The Reynolds numbers of the family.
@@ -38,13 +38,7 @@ fn control_interval(re: u32) -> f64 {
 
 /// Wake probes: 4 stations x 5 heights behind the cylinder.
 fn probes() -> Vec<[f64; 2]> {
-    let mut p = Vec::new();
-    for x in [11.0, 12.0, 13.5, 15.0] {
-        for y in [-1.0, -0.5, 0.0, 0.5, 1.0] {
-            p.push([x, y]);
-        }
-    }
-    p
+    probe_grid(&[11.0, 12.0, 13.5, 15.0], &[-1.0, -0.5, 0.0, 0.5, 1.0])
 }
 
 fn base(id: String, family: &str, re: u32, actuation: ActuationSpec, description: String) -> EnvSpec {

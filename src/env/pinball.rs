@@ -14,7 +14,7 @@
 //! 0.42 D/U. Spin-up 150 D/U: the asymmetric (pitchfork) states above Re ~ 68 take long to settle.
 
 use super::actuation::Ramp;
-use super::spec::{ActuationSpec, EnvSpec, Normalization, RewardSpec};
+use super::spec::{probe_grid, ActuationSpec, EnvSpec, Normalization, RewardSpec};
 use crate::validate::case::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
 
 pub const REYNOLDS: [u32; 4] = [30, 75, 100, 150];
@@ -32,13 +32,7 @@ fn control_interval(re: u32) -> f64 {
 }
 
 fn probes() -> Vec<[f64; 2]> {
-    let mut p = Vec::new();
-    for x in [11.5, 12.5, 14.0, 16.0] {
-        for y in [-1.5, -0.75, 0.0, 0.75, 1.5] {
-            p.push([x, y]);
-        }
-    }
-    p
+    probe_grid(&[11.5, 12.5, 14.0, 16.0], &[-1.5, -0.75, 0.0, 0.75, 1.5])
 }
 
 /// The three cylinders: front, top rear, bottom rear.

@@ -115,3 +115,8 @@ impl EnvSpec {
         toml::to_string(self).unwrap_or_else(|e| format!("# cannot print the spec as TOML: {e}\n"))
     }
 }
+
+/// Probes on the grid `xs x ys` (x-major), the usual wake rake.
+pub fn probe_grid(xs: &[f64], ys: &[f64]) -> Vec<[f64; 2]> {
+    xs.iter().flat_map(|&x| ys.iter().map(move |&y| [x, y])).collect()
+}

@@ -7,7 +7,7 @@
 //! general path, which reads in order: load, boundaries, moments, collide, store.
 
 use super::boundary::{bouzidi, side_value};
-use super::collision::{collide_les, Relax};
+use super::collision::{collide_les, Collision, Relax};
 use super::domain::Sides;
 use super::lattice::{CX, CY, Q};
 
@@ -262,8 +262,33 @@ fn store_fence() {
     };
 }
 
+/// A row function: `(context, source array, destination row, y)`.
+pub(crate) type RowFn = fn(&KernelCtx, &[f32], &mut [f32], usize);
+
+/// The row function compiled for one choice of operator, forcing and subgrid model (the
+/// subgrid model exists only for the regularised operator); `reference` picks the slow oracle.
+pub(crate) fn row_fn(collision: Collision, forced: bool, les: bool, reference: bool) -> RowFn {
+    macro_rules! pick {
+        ($reg:literal, $forced:literal, $les:literal) => {
+            if reference {
+                row_reference::<$reg, $forced, $les>
+            } else {
+                row_kernel::<$reg, $forced, $les>
+            }
+        };
+    }
+    match (collision, forced, les) {
+        (Collision::Bgk, false, _) => pick!(false, false, false),
+        (Collision::Bgk, true, _) => pick!(false, true, false),
+        (Collision::Regularized, false, false) => pick!(true, false, false),
+        (Collision::Regularized, true, false) => pick!(true, true, false),
+        (Collision::Regularized, false, true) => pick!(true, false, true),
+        (Collision::Regularized, true, true) => pick!(true, true, true),
+    }
+}
+
 /// One row of the step: vectorised interior, then the special nodes.
-pub(crate) fn row_kernel<const REG: bool, const FORCED: bool, const LES: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
+fn row_kernel<const REG: bool, const FORCED: bool, const LES: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
     let nx = c.nx;
     let bulk = c.periodic_y || (y > 0 && y + 1 < c.ny);
     if bulk {
@@ -294,7 +319,7 @@ pub(crate) fn row_kernel<const REG: bool, const FORCED: bool, const LES: bool>(c
 }
 
 /// The same row, every node through the general path (the slow oracle of the tests).
-pub(crate) fn row_reference<const REG: bool, const FORCED: bool, const LES: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
+fn row_reference<const REG: bool, const FORCED: bool, const LES: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
     let specials = &c.specials[c.row_start[y] as usize..c.row_start[y + 1] as usize];
     for x in 0..c.nx {
         let plain = Special {

@@ -10,7 +10,7 @@ use super::collision::{equilibrium, moments, Collision, Relax};
 use super::domain::{Grid, Side, Sides};
 use super::error::LbmError;
 use super::forces::link_forces;
-use super::kernel::{row_kernel, KernelCtx, Link, Special};
+use super::kernel::{row_fn, KernelCtx, Link, Special};
 use super::lattice::{CX, CY, OPP, Q};
 use crate::geometry::Shape;
 
@@ -372,15 +372,8 @@ impl D2q9 {
         let row_len = Q * self.cfg.nx;
         let forced = self.cfg.body_force != [0.0, 0.0];
         let rows = self.f_next.par_chunks_mut(row_len).enumerate().with_min_len(4);
-        let les = self.cfg.smagorinsky > 0.0;
-        match (self.cfg.collision, forced, les) {
-            (Collision::Bgk, false, _) => rows.for_each(|(y, row)| row_kernel::<false, false, false>(&ctx, src, row, y)),
-            (Collision::Bgk, true, _) => rows.for_each(|(y, row)| row_kernel::<false, true, false>(&ctx, src, row, y)),
-            (Collision::Regularized, false, false) => rows.for_each(|(y, row)| row_kernel::<true, false, false>(&ctx, src, row, y)),
-            (Collision::Regularized, true, false) => rows.for_each(|(y, row)| row_kernel::<true, true, false>(&ctx, src, row, y)),
-            (Collision::Regularized, false, true) => rows.for_each(|(y, row)| row_kernel::<true, false, true>(&ctx, src, row, y)),
-            (Collision::Regularized, true, true) => rows.for_each(|(y, row)| row_kernel::<true, true, true>(&ctx, src, row, y)),
-        }
+        let kernel = row_fn(self.cfg.collision, forced, self.cfg.smagorinsky > 0.0, false);
+        rows.for_each(|(y, row)| kernel(&ctx, src, row, y));
         link_forces(&ctx, src, &mut self.body_forces);
         std::mem::swap(&mut self.f, &mut self.f_next);
         self.time += 1;
@@ -603,16 +596,9 @@ impl D2q9 {
         );
         let forced = self.cfg.body_force != [0.0, 0.0];
         let row_len = Q * self.cfg.nx;
+        let kernel = row_fn(self.cfg.collision, forced, self.cfg.smagorinsky > 0.0, true);
         for (y, row) in self.f_next.chunks_mut(row_len).enumerate() {
-            let les = self.cfg.smagorinsky > 0.0;
-            match (self.cfg.collision, forced, les) {
-                (Collision::Bgk, false, _) => super::kernel::row_reference::<false, false, false>(&ctx, &self.f, row, y),
-                (Collision::Bgk, true, _) => super::kernel::row_reference::<false, true, false>(&ctx, &self.f, row, y),
-                (Collision::Regularized, false, false) => super::kernel::row_reference::<true, false, false>(&ctx, &self.f, row, y),
-                (Collision::Regularized, true, false) => super::kernel::row_reference::<true, true, false>(&ctx, &self.f, row, y),
-                (Collision::Regularized, false, true) => super::kernel::row_reference::<true, false, true>(&ctx, &self.f, row, y),
-                (Collision::Regularized, true, true) => super::kernel::row_reference::<true, true, true>(&ctx, &self.f, row, y),
-            }
+            kernel(&ctx, &self.f, row, y);
         }
         link_forces(&ctx, &self.f, &mut self.body_forces);
         std::mem::swap(&mut self.f, &mut self.f_next);
