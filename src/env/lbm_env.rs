@@ -158,8 +158,15 @@ impl LbmEnv {
         }
     }
 
+    /// The cache key covers what shapes the developed flow, not the episode length, the
+    /// observation statistics or the reward: calibration, rollouts and training share one state.
     fn cache_file(&self) -> Option<PathBuf> {
-        let hash = self.spec.hash();
+        let mut physics = self.spec.clone();
+        physics.normalization = Default::default();
+        physics.episode_actions = 0;
+        physics.probes.clear();
+        physics.reward = RewardSpec::DragLift { lift_weight: 0.0 };
+        let hash = physics.hash();
         self.cache_dir
             .as_ref()
             .map(|d| d.join(format!("{}-{}-{}.f32", self.spec.id, self.level.name(), &hash[..16])))
