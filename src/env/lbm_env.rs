@@ -124,6 +124,11 @@ impl LbmEnv {
         &self.solver
     }
 
+    /// Lattice <-> non-dimensional units at this env's level.
+    pub fn units(&self) -> &Units {
+        &self.units
+    }
+
     /// Sets the wall velocities for physical actuation `a` (units of U or U/D).
     fn actuate(&mut self, a: &[f64]) {
         let n_bodies = self.spec.bodies.len();

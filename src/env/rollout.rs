@@ -177,29 +177,10 @@ fn write(dir: &Path, summary: &RolloutManifest, m: &Metrics, env: &LbmEnv) -> Re
     );
     plots::time_series(&dir.join("rollout.png"), &title, &m.t, &panels, None)?;
     let d = &summary.spec.domain;
-    let units = hgym_solvers::lbm::Units {
-        cells_per_length: summary.spec.cells_per_length(env_level(&summary.level)) as f64,
-        u_lattice: summary.spec.lattice_velocity,
-        reynolds: summary.spec.reynolds,
-    };
-    let v = vorticity_field(env.solver(), &units, [d.x[0], d.x[1], d.y[0], d.y[1]]);
-    let vmax = plots::abs_quantile(&v.values, 0.99);
-    plots::field(
+    let v = vorticity_field(env.solver(), env.units(), [d.x[0], d.x[1], d.y[0], d.y[1]]);
+    v.write_png(
         &dir.join("vorticity.png"),
         &format!("{}: vorticity w L/U at the end", summary.env_id),
-        v.nx,
-        v.ny,
-        v.extent,
-        &v.values,
-        vmax,
     )?;
     Ok(())
-}
-
-fn env_level(name: &str) -> Level {
-    match name {
-        "coarse" => Level::Coarse,
-        "fine" => Level::Fine,
-        _ => Level::Default,
-    }
 }

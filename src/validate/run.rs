@@ -143,6 +143,16 @@ pub struct Field {
     pub values: Vec<f32>,
 }
 
+impl Field {
+    /// Writes the field as a PNG colour map titled `label`, with a symmetric colour range at the
+    /// 98th percentile of |value| (so a few extremes do not wash out the rest).
+    pub fn write_png(&self, path: &std::path::Path, label: &str) -> Result<(), String> {
+        let vmax = crate::report::plots::abs_quantile(&self.values, 0.98);
+        let title = format!("{label} (colour range +-{vmax:.2})");
+        crate::report::plots::field(path, &title, self.nx, self.ny, self.extent, &self.values, vmax)
+    }
+}
+
 /// How a run ended.
 #[derive(Clone, Debug, PartialEq)]
 pub enum RunStatus {
