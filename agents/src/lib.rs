@@ -5,9 +5,27 @@
 //! `[-1, 1]^n` (environments map them to physical bounds); observations are normalised to about
 //! `[-1, 1]`. `truncated` is true exactly on the episode's last action; `terminated` only for a
 //! real terminal state (e.g. the solver diverged, with the reason in `info`).
+//!
+//! Learning: [`nn`] (MLP with backward pass and Adam), [`ppo`], [`ddpg`], [`td3`] (one algorithm
+//! per file), classical controllers in [`baselines`], rounds of parallel episodes in
+//! [`rollout`], one type over the learners with checkpoint bytes in [`learn`], and small control
+//! tasks for tests in [`toy`].
 
+pub mod baselines;
+pub mod buffer;
+pub mod ddpg;
 mod env;
+pub mod learn;
+pub mod nn;
+pub mod noise;
+pub mod normalize;
+pub mod policy;
+pub mod ppo;
+pub mod rng;
+pub mod rollout;
 mod spaces;
+pub mod td3;
+pub mod toy;
 
 pub use env::{Env, EnvError, Info, StepResult};
 pub use spaces::BoxSpace;

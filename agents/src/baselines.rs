@@ -1,0 +1,102 @@
+//! Classical controllers as policies, on the same footing as the learners: zero, constant,
+//! uniform random, open-loop sine, and proportional-derivative feedback on an observation
+//! component or on an info value (e.g. the lift coefficient, "opposition control").
+
+use serde::{Deserialize, Serialize};
+
+use crate::env::Info;
+use crate::policy::Policy;
+use crate::rng::Rng;
+
+/// Which measured signal a feedback controller uses.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Signal {
+    /// Component `i` of the observation.
+    Obs(usize),
+    /// A value of the step's info, e.g. `"C_L"`.
+    Info(String),
+}
+
+/// The classical baselines.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Baseline {
+    /// No actuation.
+    Zero,
+    /// The same action every step.
+    Constant { value: f64 },
+    /// Uniform in [-1, 1].
+    Random,
+    /// `amplitude sin(2 pi k / period + phase)` at action k, on every actuator.
+    Sine { amplitude: f64, period: f64 },
+    /// `a = clip(-(kp e + kd (e - e_prev)))` with `e = signal - target`, on every actuator
+    /// (signs per actuator in `signs`, default all +1).
+    Pd {
+        signal: Signal,
+        kp: f64,
+        kd: f64,
+        target: f64,
+        signs: Vec<f64>,
+    },
+}
+
+/// A baseline with its running state.
+#[derive(Clone, Debug)]
+pub struct BaselinePolicy {
+    pub baseline: Baseline,
+    rng: Rng,
+    k: u64,
+    prev: Option<f64>,
+}
+
+impl BaselinePolicy {
+    pub fn new(baseline: Baseline, seed: u64) -> Self {
+        BaselinePolicy {
+            baseline,
+            rng: Rng::seed(seed),
+            k: 0,
+            prev: None,
+        }
+    }
+}
+
+impl Policy for BaselinePolicy {
+    fn reset(&mut self) {
+        self.k = 0;
+        self.prev = None;
+    }
+
+    fn act(&mut self, obs: &[f64], info: &Info, action: &mut [f64]) {
+        let k = self.k as f64;
+        self.k += 1;
+        match &self.baseline {
+            Baseline::Zero => action.iter_mut().for_each(|a| *a = 0.0),
+            Baseline::Constant { value } => action.iter_mut().for_each(|a| *a = value.clamp(-1.0, 1.0)),
+            Baseline::Random => action.iter_mut().for_each(|a| *a = 2.0 * self.rng.uniform() - 1.0),
+            Baseline::Sine { amplitude, period } => {
+                let v = amplitude * (2.0 * std::f64::consts::PI * k / period.max(1e-9)).sin();
+                action.iter_mut().for_each(|a| *a = v.clamp(-1.0, 1.0));
+            }
+            Baseline::Pd {
+                signal,
+                kp,
+                kd,
+                target,
+                signs,
+            } => {
+                let s = match signal {
+                    Signal::Obs(i) => obs.get(*i).copied().unwrap_or(0.0),
+                    Signal::Info(key) => info.get(key).unwrap_or(0.0),
+                };
+                let e = s - target;
+                let de = self.prev.map(|p| e - p).unwrap_or(0.0);
+                self.prev = Some(e);
+                let u = -(kp * e + kd * de);
+                for (j, a) in action.iter_mut().enumerate() {
+                    *a = (u * signs.get(j).copied().unwrap_or(1.0)).clamp(-1.0, 1.0);
+                }
+            }
+        }
+    }
+}
