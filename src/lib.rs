@@ -11,4 +11,5 @@
 pub mod bench;
 pub mod env;
 pub mod report;
+pub mod train;
 pub mod validate;

@@ -11,6 +11,8 @@ use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use hgym::bench::{bench_lbm, LbmBenchOptions};
+
+mod cli;
 use hgym::validate::{self, Level, LoadedCase, Options, Status, ValidateError};
 
 #[derive(Parser)]
@@ -49,6 +51,16 @@ enum Command {
     /// Run one episode of a fixed policy on an environment and write metrics, plots and a
     /// manifest (`<out>/<ID>-<policy>-seed<S>/`).
     Run(RunArgs),
+    /// Train an agent (PPO, DDPG, TD3) on an environment, with periodic evaluation, checkpoints
+    /// and a result folder (manifest, learning curve CSV + PNG, policy, metrics).
+    ///
+    /// `hgym train --env Cylinder_2D_Re100 --algo td3 --seeds 0..3` trains three seeds and writes a
+    /// summary; Ctrl-C stops after the current round with a checkpoint, `--resume DIR` continues
+    /// it (bitwise the same result as an uninterrupted run with the same thread count).
+    Train(cli::train::TrainArgs),
+    /// Evaluate a trained policy or a classical baseline: return, C_D, drag reduction against the
+    /// uncontrolled flow from the same initial states, |C_L|, actuation cost (mean +- std).
+    Eval(cli::train::EvalArgs),
 }
 
 #[derive(Args)]
@@ -143,6 +155,17 @@ enum BenchCommand {
         #[arg(long, value_enum, default_value = "regularized")]
         collision: CollisionArg,
     },
+    /// Learner speed: TD3 updates/s (256x256, batch 256), PPO epochs/s (64x64), batch-1 policy
+    /// latency, against SB3 measured on this machine. Exit 1 if short of the targets.
+    Agents {
+        #[arg(long)]
+        json: bool,
+        /// Short timings (targets not judged).
+        #[arg(long)]
+        quick: bool,
+        #[arg(long)]
+        threads: Option<usize>,
+    },
     /// Control steps (actions) per second of each environment family at coarse and default.
     Envs {
         /// Print the rows as JSON.
@@ -184,6 +207,9 @@ fn main() -> ExitCode {
         Command::Bench(BenchCommand::Envs { json, actions, quick }) => run_bench_envs(json, actions, quick),
         Command::Envs(args) => run_envs(args),
         Command::Run(args) => run_rollout(args),
+        Command::Train(args) => cli::train::run_train(args),
+        Command::Eval(args) => cli::train::run_eval(args),
+        Command::Bench(BenchCommand::Agents { json, quick, threads }) => cli::train::run_bench_agents(json, quick, threads),
     };
     match result {
         Ok(Outcome::Ok) => ExitCode::SUCCESS,

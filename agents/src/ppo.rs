@@ -79,16 +79,17 @@ struct Scratch {
     critic_tape: Tape<f32>,
 }
 
-/// One collected transition (normalised observation, raw Gaussian sample).
+/// One collected transition (normalised observation, raw Gaussian sample, its log-probability
+/// and value estimate, the scaled reward, and after GAE its advantage and return).
 #[derive(Clone, Debug)]
-struct Sample {
-    obs: Vec<f32>,
-    action: Vec<f64>,
-    logp: f64,
-    value: f64,
-    reward: f64,
-    advantage: f64,
-    ret: f64,
+pub struct Sample {
+    pub obs: Vec<f32>,
+    pub action: Vec<f64>,
+    pub logp: f64,
+    pub value: f64,
+    pub reward: f64,
+    pub advantage: f64,
+    pub ret: f64,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -267,7 +268,7 @@ impl Ppo {
     }
 
     /// `n_epochs` passes of shuffled minibatches over the rollout.
-    fn update(&mut self, samples: &[Sample]) {
+    pub fn update(&mut self, samples: &[Sample]) {
         let (o, a, m) = (self.obs_dim, self.act_dim, self.cfg.minibatch_size.max(1));
         let n = samples.len();
         let mut order: Vec<usize> = (0..n).collect();

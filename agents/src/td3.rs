@@ -239,6 +239,11 @@ impl Td3 {
         Ok(acc.into_iter().map(|a| a.finish()).collect())
     }
 
+    /// Stores a transition (for replaying recorded data, and for benchmarks).
+    pub fn remember(&mut self, obs: &[f64], action: &[f64], reward: f64, next_obs: &[f64], terminal: bool) {
+        self.buffer.push(obs, action, reward, next_obs, terminal);
+    }
+
     /// One gradient update from a sampled minibatch.
     pub fn update(&mut self) {
         let (o, a, b) = (self.obs_dim, self.act_dim, self.cfg.batch_size);

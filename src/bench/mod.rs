@@ -10,6 +10,7 @@
 //! single-thread rows are reported beside it (one core is bound by arithmetic, not memory: its
 //! rate from memory matches its rate from the last-level cache).
 
+pub mod agents;
 pub mod envs;
 mod lbm;
 mod stream;

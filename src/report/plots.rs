@@ -237,3 +237,157 @@ pub fn abs_quantile(values: &[f32], q: f64) -> f64 {
     let (_, v, _) = a.select_nth_unstable_by(k, |x, y| x.total_cmp(y));
     *v as f64
 }
+
+/// One line of a multi-line chart: points `(x, y)` (non-finite y are skipped), an optional
+/// shaded band `y +- band` (e.g. the spread over seeds).
+pub struct Line<'a> {
+    pub label: &'a str,
+    pub x: &'a [f64],
+    pub y: &'a [f64],
+    pub band: Option<&'a [f64]>,
+}
+
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+];
+
+/// Several lines in one panel with a legend (learning curves of several runs).
+pub fn lines(path: &Path, title: &str, x_label: &str, y_label: &str, lines: &[Line]) -> Result<(), String> {
+    fonts();
+    let root = BitMapBackend::new(path, (1100, 600)).into_drawing_area();
+    root.fill(&WHITE).map_err(err(path))?;
+    let finite = |v: &f64| v.is_finite();
+    let xs: Vec<f64> = lines.iter().flat_map(|l| l.x.iter().copied()).filter(finite).collect();
+    let mut ys: Vec<f64> = vec![];
+    for l in lines {
+        for (i, y) in l.y.iter().enumerate() {
+            let b = l.band.and_then(|b| b.get(i)).copied().unwrap_or(0.0);
+            if y.is_finite() {
+                ys.extend([y - b.abs(), y + b.abs()]);
+            }
+        }
+    }
+    let x0 = xs.iter().copied().fold(f64::INFINITY, f64::min);
+    let x1 = xs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let x_range = if x0.is_finite() && x1 > x0 { x0..x1 } else { 0.0..1.0 };
+    let y = if ys.is_empty() { -1.0..1.0 } else { range_of(&ys) };
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 22))
+        .margin(14)
+        .x_label_area_size(45)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x_range, y.clone())
+        .map_err(err(path))?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .label_style(("sans-serif", 15))
+        .draw()
+        .map_err(err(path))?;
+    for (k, l) in lines.iter().enumerate() {
+        let c = PALETTE[k % PALETTE.len()];
+        let pts: Vec<(f64, f64, f64)> =
+            l.x.iter()
+                .zip(l.y)
+                .enumerate()
+                .filter(|(_, (x, y))| x.is_finite() && y.is_finite())
+                .map(|(i, (x, y))| (*x, *y, l.band.and_then(|b| b.get(i)).copied().unwrap_or(0.0).abs()))
+                .collect();
+        if l.band.is_some() && pts.len() > 1 {
+            let mut poly: Vec<(f64, f64)> = pts
+                .iter()
+                .map(|(x, y, b)| (*x, (y + b).clamp(y_lo(&chart), y_hi(&chart))))
+                .collect();
+            poly.extend(pts.iter().rev().map(|(x, y, b)| (*x, (y - b).clamp(y_lo(&chart), y_hi(&chart)))));
+            chart
+                .draw_series(std::iter::once(Polygon::new(poly, c.mix(0.18).filled())))
+                .map_err(err(path))?;
+        }
+        chart
+            .draw_series(LineSeries::new(pts.iter().map(|(x, y, _)| (*x, *y)), c.stroke_width(2)))
+            .map_err(err(path))?
+            .label(l.label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
+        if pts.len() <= 60 {
+            chart
+                .draw_series(pts.iter().map(|(x, y, _)| Circle::new((*x, *y), 3, c.filled())))
+                .map_err(err(path))?;
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(err(path))?;
+    root.present().map_err(err(path))?;
+    Ok(())
+}
+
+fn y_lo<DB: DrawingBackend>(
+    c: &ChartContext<DB, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>,
+) -> f64 {
+    c.y_range().start
+}
+
+fn y_hi<DB: DrawingBackend>(
+    c: &ChartContext<DB, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>,
+) -> f64 {
+    c.y_range().end
+}
+
+/// Bars with error whiskers (a leaderboard per environment): `(label, mean, std)`.
+pub fn bars(path: &Path, title: &str, y_label: &str, bars: &[(String, f64, f64)]) -> Result<(), String> {
+    fonts();
+    let root = BitMapBackend::new(path, (200 + 140 * bars.len().max(1) as u32, 600)).into_drawing_area();
+    root.fill(&WHITE).map_err(err(path))?;
+    let lo = bars.iter().map(|b| b.1 - b.2.abs()).fold(0.0, f64::min);
+    let hi = bars.iter().map(|b| b.1 + b.2.abs()).fold(0.0, f64::max);
+    let pad = ((hi - lo) * 0.1).max(1e-3);
+    let n = bars.len().max(1);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 22))
+        .margin(14)
+        .x_label_area_size(60)
+        .y_label_area_size(80)
+        .build_cartesian_2d(0.0..n as f64, (lo - pad)..(hi + pad))
+        .map_err(err(path))?;
+    let labels: Vec<String> = bars.iter().map(|b| b.0.clone()).collect();
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(n)
+        .x_label_formatter(&|x| labels.get(x.floor() as usize).cloned().unwrap_or_default())
+        .y_desc(y_label)
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err(path))?;
+    for (k, (_, mean, std)) in bars.iter().enumerate() {
+        let c = PALETTE[k % PALETTE.len()];
+        let x = k as f64;
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [(x + 0.15, 0.0), (x + 0.85, *mean)],
+                c.mix(0.8).filled(),
+            )))
+            .map_err(err(path))?;
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(x + 0.5, mean - std), (x + 0.5, mean + std)],
+                BLACK.stroke_width(2),
+            )))
+            .map_err(err(path))?;
+    }
+    root.present().map_err(err(path))?;
+    Ok(())
+}

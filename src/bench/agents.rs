@@ -1,0 +1,148 @@
+//! `hgym bench agents`: learner speed at the sizes the paper's baselines use, next to the peer
+//! measured on this machine (SB3 2.x, PyTorch, 2 threads: TD3 with 256x256 actor and critics at
+//! batch 256 does 116-135 gradient updates per second, and `predict` on one observation takes
+//! about 200 us). Targets: at least 1.2x SB3's best update rate, batch-1 policy evaluation under
+//! 10 us. Shapes: observation 60 (the cylinder's 20 probes x (u, v, p)), 1 action.
+
+use std::time::Instant;
+
+use hgym_agents::nn::{Activation, Init, Mlp};
+use hgym_agents::policy::{ActorPolicy, Policy};
+use hgym_agents::ppo::{Ppo, PpoConfig, Sample};
+use hgym_agents::rng::Rng;
+use hgym_agents::td3::{Td3, Td3Config};
+use hgym_agents::Info;
+use serde::{Deserialize, Serialize};
+
+/// SB3 TD3 updates per second on this machine (upper end of the measured range).
+pub const SB3_TD3_UPDATES_PER_S: f64 = 135.0;
+/// SB3 `predict` on one observation, microseconds.
+pub const SB3_PREDICT_US: f64 = 200.0;
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct AgentsBench {
+    pub obs_dim: usize,
+    pub act_dim: usize,
+    pub threads: usize,
+    pub td3_updates_per_s: f64,
+    pub td3_ratio_to_sb3: f64,
+    /// PPO epochs per second over a 2048-sample rollout, minibatch 64, 64x64 networks.
+    pub ppo_epochs_per_s: f64,
+    pub ppo_minibatch_updates_per_s: f64,
+    /// Deterministic action of a 256x256 actor (TD3's) and a 64x64 one (PPO's), batch 1.
+    pub td3_policy_us: f64,
+    pub ppo_policy_us: f64,
+    pub pass: bool,
+}
+
+fn best_of<F: FnMut() -> f64>(n: usize, mut f: F) -> f64 {
+    (0..n).map(|_| f()).fold(f64::INFINITY, f64::min)
+}
+
+pub fn bench_agents(quick: bool) -> AgentsBench {
+    let (o, a) = (60, 1);
+    let mut rng = Rng::seed(1);
+    let obs = |rng: &mut Rng| -> Vec<f64> { (0..o).map(|_| rng.normal()).collect() };
+
+    // TD3: fill a buffer, warm up, time updates.
+    let mut td3 = Td3::new("td3", Td3Config::default(), o, a, 0);
+    for _ in 0..10_000 {
+        let (s, s2) = (obs(&mut rng), obs(&mut rng));
+        td3.remember(&s, &[2.0 * rng.uniform() - 1.0], rng.normal(), &s2, false);
+    }
+    for _ in 0..10 {
+        td3.update();
+    }
+    let n = if quick { 40 } else { 200 };
+    let td3_s = best_of(3, || {
+        let t = Instant::now();
+        for _ in 0..n {
+            td3.update();
+        }
+        t.elapsed().as_secs_f64() / n as f64
+    });
+
+    // PPO: 10 epochs over 2048 samples with minibatch 64.
+    let mut ppo = Ppo::new(PpoConfig::default(), o, a, 0);
+    let samples: Vec<Sample> = (0..2048)
+        .map(|_| {
+            let x = obs(&mut rng);
+            Sample {
+                obs: x.iter().map(|v| *v as f32).collect(),
+                action: vec![rng.normal()],
+                logp: -1.0,
+                value: 0.0,
+                reward: rng.normal(),
+                advantage: rng.normal(),
+                ret: rng.normal(),
+            }
+        })
+        .collect();
+    let reps = if quick { 1 } else { 3 };
+    let ppo_s = best_of(reps, || {
+        let t = Instant::now();
+        ppo.update(&samples);
+        t.elapsed().as_secs_f64() / ppo.cfg.n_epochs as f64
+    });
+    let minibatches = 2048usize.div_ceil(ppo.cfg.minibatch_size) as f64;
+
+    // Batch-1 deterministic actions.
+    let policy_us = |hidden: &[usize], rng: &mut Rng| {
+        let mut sizes = vec![o];
+        sizes.extend(hidden);
+        sizes.push(a);
+        let net = Mlp::new(&sizes, Activation::Relu, Activation::Tanh, Init::FanIn, Init::FanIn, rng);
+        let mut p = ActorPolicy::new("bench", net, None, 10.0);
+        let x = obs(rng);
+        let info = Info::default();
+        let mut act = vec![0.0; a];
+        for _ in 0..100 {
+            p.act(&x, &info, &mut act);
+        }
+        let reps = if quick { 2000 } else { 20_000 };
+        best_of(3, || {
+            let t = Instant::now();
+            for _ in 0..reps {
+                p.act(&x, &info, &mut act);
+            }
+            t.elapsed().as_secs_f64() * 1e6 / reps as f64
+        })
+    };
+    let td3_policy_us = policy_us(&[256, 256], &mut rng);
+    let ppo_policy_us = policy_us(&[64, 64], &mut rng);
+    let td3_rate = 1.0 / td3_s;
+    AgentsBench {
+        obs_dim: o,
+        act_dim: a,
+        threads: rayon::current_num_threads(),
+        td3_updates_per_s: td3_rate,
+        td3_ratio_to_sb3: td3_rate / SB3_TD3_UPDATES_PER_S,
+        ppo_epochs_per_s: 1.0 / ppo_s,
+        ppo_minibatch_updates_per_s: minibatches / ppo_s,
+        td3_policy_us,
+        ppo_policy_us,
+        pass: td3_rate >= 1.2 * SB3_TD3_UPDATES_PER_S && td3_policy_us < 10.0 && ppo_policy_us < 10.0,
+    }
+}
+
+pub fn table(b: &AgentsBench) -> String {
+    format!(
+        "learner speed (obs {}, act {}, {} threads)\n\
+         TD3 256x256, batch 256   {:8.1} updates/s   {:.2}x SB3 ({:.0}/s; target >= 1.2x)\n\
+         PPO 64x64, 2048 x mb 64  {:8.2} epochs/s    ({:.0} minibatch updates/s)\n\
+         policy, batch 1          {:8.2} us (256x256)  {:.2} us (64x64)   SB3 predict ~{:.0} us; target < 10 us\n\
+         {}\n",
+        b.obs_dim,
+        b.act_dim,
+        b.threads,
+        b.td3_updates_per_s,
+        b.td3_ratio_to_sb3,
+        SB3_TD3_UPDATES_PER_S,
+        b.ppo_epochs_per_s,
+        b.ppo_minibatch_updates_per_s,
+        b.td3_policy_us,
+        b.ppo_policy_us,
+        SB3_PREDICT_US,
+        if b.pass { "PASS" } else { "SHORT of target" }
+    )
+}

@@ -1,0 +1,3 @@
+//! Subcommands of the binary that grew past a few lines: `train`, `eval`, `bench agents`.
+
+pub mod train;

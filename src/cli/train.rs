@@ -1,0 +1,410 @@
+//! `hgym train`, `hgym eval` and `hgym bench agents`.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+use anyhow::{Context, Result};
+use clap::Args;
+use hgym::env::LbmEnv;
+use hgym::train::config::TrainConfig;
+use hgym::train::eval::{evaluate, parse_policy, uncontrolled_c_d, EvalReport, NamedPolicy};
+use hgym::train::{resolve_spec, resume_options, summarize, Ending, TrainError, TrainOptions};
+use hgym::validate::Level;
+use hgym_agents::baselines::BaselinePolicy;
+use hgym_agents::learn::Algo;
+use hgym_agents::policy::Policy;
+
+use crate::{progress_bar, thread_pool, Outcome, UsageError};
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum AlgoArg {
+    Ppo,
+    Ddpg,
+    Td3,
+}
+
+impl From<AlgoArg> for Algo {
+    fn from(a: AlgoArg) -> Algo {
+        match a {
+            AlgoArg::Ppo => Algo::Ppo,
+            AlgoArg::Ddpg => Algo::Ddpg,
+            AlgoArg::Td3 => Algo::Td3,
+        }
+    }
+}
+
+#[derive(Args)]
+pub struct TrainArgs {
+    /// Environment ID (`hgym envs` lists them), e.g. Cylinder_2D_Re100.
+    #[arg(long, required_unless_present_any = ["resume", "print_config"])]
+    env: Option<String>,
+    /// Learning algorithm.
+    #[arg(long, value_enum, default_value = "td3")]
+    algo: AlgoArg,
+    /// Seed of the learner and of every episode's initial phase.
+    #[arg(long, default_value_t = 0, conflicts_with = "seeds")]
+    seed: u64,
+    /// Several seeds, one run each, then a summary: `0..3` (0, 1, 2), `0..=4`, or `1,5,9`.
+    #[arg(long)]
+    seeds: Option<String>,
+    /// Environment transitions to collect (default: the config's `train.steps`, 20000).
+    #[arg(long)]
+    steps: Option<u64>,
+    /// Resolution level. Training defaults to coarse: the default level costs ~30x more per action.
+    #[arg(long = "res", value_enum, default_value_t = Level::Coarse)]
+    level: Level,
+    /// TOML file overriding the defaults: [train], [ppo], [ddpg], [td3], [env] (see --print-config).
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Where result folders go: <out>/<ID>-<algo>-<level>/seed<S>/.
+    #[arg(long, default_value = "results/train")]
+    out: PathBuf,
+    /// Continue a run (killed or finished) from its folder's checkpoint; --steps may raise the budget.
+    #[arg(long, conflicts_with_all = ["env", "seeds", "config"])]
+    resume: Option<PathBuf>,
+    /// Print the effective configuration as TOML and exit.
+    #[arg(long)]
+    print_config: bool,
+    /// Print the final metrics as JSON.
+    #[arg(long)]
+    json: bool,
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+#[derive(Args)]
+pub struct EvalArgs {
+    /// A training result folder (its policy.json), or a baseline: zero, random, sine[=period],
+    /// constant=v, opposition[=gain] (a = -gain C_L), pd=SIGNAL,kp,kd (SIGNAL: obs:i or an info key).
+    #[arg(long)]
+    policy: String,
+    /// Environment ID; a policy trained on another flow works if the observation and action sizes match.
+    #[arg(long)]
+    env: String,
+    #[arg(long, default_value_t = 3)]
+    episodes: usize,
+    #[arg(long = "res", value_enum, default_value_t = Level::Coarse)]
+    level: Level,
+    /// Episode k starts from reset(eval_seed + k); the default matches training's evaluation.
+    #[arg(long, default_value_t = 1_000_000)]
+    eval_seed: u64,
+    /// TOML file whose [env] table overrides the environment spec.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Also write the report to <out>/<ID>-<policy>-<level>/metrics.json (+ manifest.json).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    #[arg(long)]
+    json: bool,
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+static SIGNALS: AtomicUsize = AtomicUsize::new(0);
+
+/// First Ctrl-C: finish the current round, write the checkpoint, exit 130. Second: exit now
+/// (the last checkpoint stays valid: checkpoints are replaced atomically).
+fn install_interrupt() {
+    let _ = ctrlc::set_handler(|| {
+        INTERRUPTED.store(true, Ordering::SeqCst);
+        if SIGNALS.fetch_add(1, Ordering::SeqCst) >= 1 {
+            eprintln!("\ninterrupted twice: exiting without a new checkpoint (the previous one is intact)");
+            std::process::exit(130);
+        }
+        eprintln!("\ninterrupted: finishing the current round, then writing the checkpoint (Ctrl-C again to quit now)");
+    });
+}
+
+fn load_config(path: Option<&Path>) -> Result<TrainConfig> {
+    match path {
+        None => Ok(TrainConfig::default()),
+        Some(p) => {
+            let text = std::fs::read_to_string(p).with_context(|| format!("cannot read the config file {}", p.display()))?;
+            TrainConfig::parse(&text, &p.display().to_string()).map_err(|e| UsageError(e).into())
+        }
+    }
+}
+
+/// `0..3`, `0..=4`, `1,5,9`.
+fn parse_seeds(text: &str) -> Result<Vec<u64>> {
+    let bad = || UsageError(format!("--seeds {text}: expected a range like 0..3 or 0..=4, or a list like 1,5,9"));
+    let num = |s: &str| s.trim().parse::<u64>().map_err(|_| bad());
+    let seeds: Vec<u64> = if let Some((a, b)) = text.split_once("..=") {
+        (num(a)?..=num(b)?).collect()
+    } else if let Some((a, b)) = text.split_once("..") {
+        (num(a)?..num(b)?).collect()
+    } else {
+        text.split(',').map(num).collect::<Result<_, _>>()?
+    };
+    if seeds.is_empty() {
+        return Err(bad().into());
+    }
+    Ok(seeds)
+}
+
+fn train_error(e: TrainError) -> anyhow::Error {
+    match e {
+        TrainError::Input(m) => UsageError(m).into(),
+        other => anyhow::Error::new(other),
+    }
+}
+
+pub fn run_train(args: TrainArgs) -> Result<Outcome> {
+    let mut config = load_config(args.config.as_deref())?;
+    if let Some(s) = args.steps {
+        config.train.steps = s;
+    }
+    if args.print_config {
+        print!("{}", config.to_toml());
+        return Ok(Outcome::Ok);
+    }
+    let (pool, _) = thread_pool(args.threads)?;
+    install_interrupt();
+    let cache = hgym::env::default_cache_dir();
+    let jobs: Vec<(TrainOptions, Option<hgym::train::checkpoint::Checkpoint>)> = if let Some(dir) = &args.resume {
+        let (opts, ck) = resume_options(dir, args.steps, cache).map_err(train_error)?;
+        eprintln!(
+            "resuming {} {} seed {} at {} samples (round {})",
+            opts.env_id,
+            opts.algo.name(),
+            opts.seed,
+            ck.curve.last().map(|r| r.samples).unwrap_or(0),
+            ck.curve.len()
+        );
+        vec![(opts, Some(ck))]
+    } else {
+        let env_id = args.env.clone().unwrap_or_default();
+        let algo: Algo = args.algo.into();
+        resolve_spec(&env_id, &config).map_err(train_error)?;
+        let seeds = match &args.seeds {
+            Some(s) => parse_seeds(s)?,
+            None => vec![args.seed],
+        };
+        let root = args.out.join(format!("{env_id}-{}-{}", algo.name(), args.level.name()));
+        seeds
+            .iter()
+            .map(|s| {
+                (
+                    TrainOptions {
+                        env_id: env_id.clone(),
+                        algo,
+                        seed: *s,
+                        level: args.level,
+                        config: config.clone(),
+                        out: root.join(format!("seed{s}")),
+                        cache: cache.clone(),
+                    },
+                    None,
+                )
+            })
+            .collect()
+    };
+    let mut finished = vec![];
+    for (opts, ck) in jobs {
+        let label = format!("{} s{}", opts.algo.name(), opts.seed);
+        let pb = progress_bar(opts.config.train.steps, &label);
+        if let Some(ck) = &ck {
+            pb.set_position(ck.curve.last().map(|r| r.samples).unwrap_or(0));
+        }
+        let ending = pool
+            .install(|| {
+                hgym::train::train(
+                    &opts,
+                    ck,
+                    &mut |p| {
+                        pb.set_position(p.samples.min(p.total));
+                        let eval = p
+                            .last_eval
+                            .map(|(r, dr)| format!(" | eval return {r:.1}, drag reduction {dr:+.1}%"))
+                            .unwrap_or_default();
+                        pb.set_message(format!("{label} return {:.1} C_D {:.3}{eval}", p.train_return, p.train_c_d));
+                        if !pb.is_hidden() {
+                            return;
+                        }
+                        if p.round % 10 == 0 {
+                            eprintln!(
+                                "{label}: {} / {} samples, return {:.2}, C_D {:.4}{eval}",
+                                p.samples, p.total, p.train_return, p.train_c_d
+                            );
+                        }
+                    },
+                    &|| INTERRUPTED.load(Ordering::SeqCst),
+                )
+            })
+            .map_err(train_error)
+            .with_context(|| format!("training {} on {}", opts.algo.name(), opts.env_id))?;
+        pb.finish_and_clear();
+        match ending {
+            Ending::Interrupted { samples } => {
+                eprintln!(
+                    "stopped at {samples} samples; checkpoint written. Continue with: hgym train --resume {}",
+                    opts.out.display()
+                );
+                std::process::exit(130);
+            }
+            Ending::Finished(report) => {
+                if !args.json {
+                    println!(
+                        "{} {} seed {}: drag reduction {:+.2} % +- {:.2} (C_D {:.4} vs {:.4} uncontrolled), return {:.2} +- {:.2} over {} episodes",
+                        opts.env_id,
+                        opts.algo.name(),
+                        opts.seed,
+                        report.drag_reduction_pct.mean,
+                        report.drag_reduction_pct.std,
+                        report.mean_c_d.mean,
+                        report.uncontrolled_c_d.mean,
+                        report.ret.mean,
+                        report.ret.std,
+                        report.episodes.len()
+                    );
+                    println!("  results: {}", opts.out.display());
+                }
+                finished.push((opts.seed, opts.out.clone(), *report, opts.clone()));
+            }
+        }
+    }
+    if finished.len() > 1 {
+        let o = &finished[0].3;
+        let runs: Vec<_> = finished.iter().map(|(s, p, r, _)| (*s, p.clone(), r.clone())).collect();
+        let summary = summarize(&o.env_id, o.algo.name(), o.level.name(), &runs);
+        let root = o.out.parent().unwrap_or(Path::new("."));
+        std::fs::write(root.join("summary.json"), serde_json::to_string_pretty(&summary)? + "\n")
+            .with_context(|| format!("cannot write {}", root.join("summary.json").display()))?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&summary)?);
+        } else {
+            println!(
+                "{} {} over seeds {:?}: drag reduction {:+.2} % +- {:.2} (std over seeds), return {:.2} +- {:.2}\n  summary: {}",
+                summary.env_id,
+                summary.algo,
+                summary.seeds,
+                summary.drag_reduction_pct.mean,
+                summary.drag_reduction_pct.std,
+                summary.ret.mean,
+                summary.ret.std,
+                root.join("summary.json").display()
+            );
+        }
+    } else if args.json {
+        if let Some((_, _, r, _)) = finished.first() {
+            println!("{}", serde_json::to_string_pretty(r)?);
+        }
+    }
+    Ok(Outcome::Ok)
+}
+
+pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
+    if args.episodes == 0 {
+        return Err(UsageError("--episodes must be at least 1".into()).into());
+    }
+    let config = load_config(args.config.as_deref())?;
+    let spec = resolve_spec(&args.env, &config).map_err(train_error)?;
+    let named = parse_policy(&args.policy).map_err(UsageError)?;
+    let (mut policy, name): (Box<dyn Policy + Send>, String) = match named {
+        NamedPolicy::Trained(p) => {
+            if p.obs_dim() != spec.obs_dim() || p.act_dim() != spec.act_dim() {
+                return Err(UsageError(format!(
+                    "the policy in {} maps {} observations to {} actions, but {} has {} observations and {} actions: \
+                     transfer between flows needs matching sizes (same probe count and actuators)",
+                    args.policy,
+                    p.obs_dim(),
+                    p.act_dim(),
+                    spec.id,
+                    spec.obs_dim(),
+                    spec.act_dim()
+                ))
+                .into());
+            }
+            let name = format!("{} ({})", p.algo, args.policy);
+            (p, name)
+        }
+        NamedPolicy::Baseline(b) => (Box::new(BaselinePolicy::new(b, args.eval_seed)), args.policy.clone()),
+    };
+    let (pool, threads) = thread_pool(args.threads)?;
+    let started = std::time::Instant::now();
+    let seeds: Vec<u64> = (0..args.episodes as u64).map(|k| args.eval_seed + k).collect();
+    let pb = progress_bar(2 * args.episodes as u64, &spec.id);
+    let report: EvalReport = pool
+        .install(|| -> Result<EvalReport> {
+            let mut env = LbmEnv::new(spec.clone(), args.level, hgym::env::default_cache_dir())?;
+            let reference = uncontrolled_c_d(&mut env, &seeds)?;
+            pb.set_position(args.episodes as u64);
+            let hash = spec.hash();
+            Ok(evaluate(
+                &mut env,
+                policy.as_mut(),
+                &name,
+                &spec.id,
+                &hash,
+                args.level.name(),
+                &seeds,
+                &reference,
+                &mut |k| pb.set_position((args.episodes + k) as u64),
+            )?)
+        })
+        .with_context(|| format!("evaluating {} on {}", args.policy, spec.id))?;
+    pb.finish_and_clear();
+    if let Some(out) = &args.out {
+        let slug: String = args
+            .policy
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() || c == '.' { c } else { '_' })
+            .collect();
+        let dir = out.join(format!("{}-{}-{}", spec.id, slug, args.level.name()));
+        std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        std::fs::write(dir.join("metrics.json"), serde_json::to_string_pretty(&report)? + "\n")?;
+        let m = hgym::report::manifest::manifest(threads, started.elapsed().as_secs_f64());
+        let manifest = serde_json::json!({
+            "schema": "hgym/eval-manifest/v1",
+            "env_id": spec.id,
+            "spec_hash": spec.hash(),
+            "spec": spec,
+            "level": args.level.name(),
+            "policy": args.policy,
+            "eval_seed": args.eval_seed,
+            "episodes": args.episodes,
+            "manifest": m,
+        });
+        std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&manifest)? + "\n")?;
+        eprintln!("results: {}", dir.display());
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!(
+            "{} on {} ({}, {} episodes)\n  return          {:10.3} +- {:.3}\n  mean C_D        {:10.4} +- {:.4}   (uncontrolled {:.4})\n  drag reduction  {:+9.2} % +- {:.2}\n  mean |C_L|      {:10.4} +- {:.4}\n  actuation cost  {:10.4} +- {:.4}   (mean sum of squared actions)",
+            report.policy,
+            report.env_id,
+            report.level,
+            report.episodes.len(),
+            report.ret.mean,
+            report.ret.std,
+            report.mean_c_d.mean,
+            report.mean_c_d.std,
+            report.uncontrolled_c_d.mean,
+            report.drag_reduction_pct.mean,
+            report.drag_reduction_pct.std,
+            report.mean_abs_c_l.mean,
+            report.mean_abs_c_l.std,
+            report.actuation_cost.mean,
+            report.actuation_cost.std
+        );
+    }
+    Ok(if report.episodes.iter().any(|e| e.terminated) {
+        Outcome::CheckFailed
+    } else {
+        Outcome::Ok
+    })
+}
+
+pub fn run_bench_agents(json: bool, quick: bool, threads: Option<usize>) -> Result<Outcome> {
+    let (pool, _) = thread_pool(threads)?;
+    let b = pool.install(|| hgym::bench::agents::bench_agents(quick));
+    if json {
+        println!("{}", serde_json::to_string_pretty(&b)?);
+    } else {
+        print!("{}", hgym::bench::agents::table(&b));
+    }
+    Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
+}

@@ -1,0 +1,203 @@
+//! Evaluation of any policy (trained actor or classical baseline) on an environment:
+//! return, mean C_D, drag reduction against the uncontrolled flow on the same episodes, mean
+//! |C_L| and actuation cost, as mean and standard deviation over episodes.
+
+use std::path::Path;
+
+use hgym_agents::baselines::{Baseline, BaselinePolicy, Signal};
+use hgym_agents::policy::{ActorPolicy, Policy};
+use hgym_agents::rollout::{episode, EpisodeStats};
+use hgym_agents::{Env, EnvError};
+use serde::{Deserialize, Serialize};
+
+/// Mean and sample standard deviation.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Stat {
+    pub mean: f64,
+    pub std: f64,
+}
+
+impl Stat {
+    pub fn of(v: &[f64]) -> Stat {
+        let n = v.len();
+        if n == 0 {
+            return Stat {
+                mean: f64::NAN,
+                std: f64::NAN,
+            };
+        }
+        let mean = v.iter().sum::<f64>() / n as f64;
+        let std = if n > 1 {
+            (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt()
+        } else {
+            0.0
+        };
+        Stat { mean, std }
+    }
+}
+
+/// One evaluation episode.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EvalEpisode {
+    pub seed: u64,
+    pub ret: f64,
+    pub length: usize,
+    pub terminated: bool,
+    pub mean_c_d: f64,
+    /// Mean C_D of the uncontrolled flow from the same initial state.
+    pub uncontrolled_c_d: f64,
+    /// `100 (1 - C_D / C_D,uncontrolled)`.
+    pub drag_reduction_pct: f64,
+    pub mean_abs_c_l: f64,
+    /// Mean over steps of the sum of squared normalised actions.
+    pub actuation_cost: f64,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EvalReport {
+    pub schema: String,
+    pub env_id: String,
+    pub spec_hash: String,
+    pub level: String,
+    pub policy: String,
+    pub episodes: Vec<EvalEpisode>,
+    pub ret: Stat,
+    pub mean_c_d: Stat,
+    pub uncontrolled_c_d: Stat,
+    pub drag_reduction_pct: Stat,
+    pub mean_abs_c_l: Stat,
+    pub actuation_cost: Stat,
+}
+
+/// The mean C_D of each uncontrolled episode from `reset(seed)` for `seeds`.
+pub fn uncontrolled_c_d<E: Env + ?Sized>(env: &mut E, seeds: &[u64]) -> Result<Vec<f64>, EnvError> {
+    let mut zero = BaselinePolicy::new(Baseline::Zero, 0);
+    seeds
+        .iter()
+        .map(|s| {
+            Ok(episode(env, &mut zero, *s, &mut |_, _| {})?
+                .info_means
+                .get("C_D")
+                .copied()
+                .unwrap_or(f64::NAN))
+        })
+        .collect()
+}
+
+/// Runs `policy` for one episode per seed; `reference` is the uncontrolled C_D per seed.
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate<E: Env + ?Sized>(
+    env: &mut E,
+    policy: &mut dyn Policy,
+    policy_name: &str,
+    env_id: &str,
+    spec_hash: &str,
+    level: &str,
+    seeds: &[u64],
+    reference: &[f64],
+    progress: &mut dyn FnMut(usize),
+) -> Result<EvalReport, EnvError> {
+    let mut episodes = vec![];
+    for (k, (seed, c_d0)) in seeds.iter().zip(reference).enumerate() {
+        let mut cost = 0.0;
+        let stats: EpisodeStats = episode(env, policy, *seed, &mut |a, _| cost += a.iter().map(|v| v * v).sum::<f64>())?;
+        let mean_c_d = stats.info_means.get("C_D").copied().unwrap_or(f64::NAN);
+        episodes.push(EvalEpisode {
+            seed: *seed,
+            ret: stats.ret,
+            length: stats.length,
+            terminated: stats.terminated,
+            mean_c_d,
+            uncontrolled_c_d: *c_d0,
+            drag_reduction_pct: 100.0 * (1.0 - mean_c_d / c_d0),
+            mean_abs_c_l: stats.info_means.get("abs_C_L").copied().unwrap_or(f64::NAN),
+            actuation_cost: cost / stats.length.max(1) as f64,
+        });
+        progress(k + 1);
+    }
+    let col = |f: fn(&EvalEpisode) -> f64| Stat::of(&episodes.iter().map(f).collect::<Vec<_>>());
+    Ok(EvalReport {
+        schema: "hgym/eval/v1".into(),
+        env_id: env_id.into(),
+        spec_hash: spec_hash.into(),
+        level: level.into(),
+        policy: policy_name.into(),
+        ret: col(|e| e.ret),
+        mean_c_d: col(|e| e.mean_c_d),
+        uncontrolled_c_d: col(|e| e.uncontrolled_c_d),
+        drag_reduction_pct: col(|e| e.drag_reduction_pct),
+        mean_abs_c_l: col(|e| e.mean_abs_c_l),
+        actuation_cost: col(|e| e.actuation_cost),
+        episodes,
+    })
+}
+
+/// A policy named on the command line: a trained-run folder (its `policy.json`), or a
+/// classical baseline: `zero`, `random`, `sine[=period]`, `constant=v`, `opposition[=gain]`
+/// (proportional feedback against the lift, `a = -gain C_L`), `pd=SIGNAL,kp,kd` with SIGNAL
+/// `obs:i` or an info key such as `C_L`.
+pub enum NamedPolicy {
+    Trained(Box<ActorPolicy>),
+    Baseline(Baseline),
+}
+
+pub fn parse_policy(text: &str) -> Result<NamedPolicy, String> {
+    let (name, arg) = text.split_once('=').map(|(a, b)| (a, Some(b))).unwrap_or((text, None));
+    let num = |s: &str| {
+        s.trim()
+            .parse::<f64>()
+            .map_err(|_| format!("'{s}' in --policy {text} is not a number"))
+    };
+    let b = match (name, arg) {
+        ("zero", None) => Baseline::Zero,
+        ("random", None) => Baseline::Random,
+        ("sine", p) => Baseline::Sine {
+            amplitude: 1.0,
+            period: p.map(num).transpose()?.unwrap_or(20.0),
+        },
+        ("constant", Some(v)) => Baseline::Constant { value: num(v)? },
+        ("opposition", g) => Baseline::Pd {
+            signal: Signal::Info("C_L".into()),
+            kp: g.map(num).transpose()?.unwrap_or(1.0),
+            kd: 0.0,
+            target: 0.0,
+            signs: vec![],
+        },
+        ("pd", Some(spec)) => {
+            let parts: Vec<&str> = spec.split(',').collect();
+            if parts.len() != 3 {
+                return Err(format!(
+                    "--policy {text}: expected pd=SIGNAL,kp,kd (e.g. pd=C_L,1.0,0.5 or pd=obs:3,0.5,0)"
+                ));
+            }
+            let signal = match parts[0].strip_prefix("obs:") {
+                Some(i) => Signal::Obs(
+                    i.parse()
+                        .map_err(|_| format!("--policy {text}: '{i}' is not an observation index"))?,
+                ),
+                None => Signal::Info(parts[0].to_string()),
+            };
+            Baseline::Pd {
+                signal,
+                kp: num(parts[1])?,
+                kd: num(parts[2])?,
+                target: 0.0,
+                signs: vec![],
+            }
+        }
+        _ => {
+            let dir = Path::new(text);
+            let file = if dir.is_dir() { dir.join("policy.json") } else { dir.to_path_buf() };
+            if !file.exists() {
+                return Err(format!(
+                    "--policy {text}: neither a result folder with policy.json nor a baseline \
+                     (zero, random, sine[=period], constant=v, opposition[=gain], pd=SIGNAL,kp,kd)"
+                ));
+            }
+            let body = std::fs::read_to_string(&file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
+            let p: ActorPolicy = serde_json::from_str(&body).map_err(|e| format!("{} is not a policy file: {e}", file.display()))?;
+            return Ok(NamedPolicy::Trained(Box::new(p)));
+        }
+    };
+    Ok(NamedPolicy::Baseline(b))
+}

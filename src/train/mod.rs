@@ -1,0 +1,330 @@
+//! `hgym train`: runs a learner from `hgym-agents` on a flow environment, in rounds (one episode
+//! on each of the learner's parallel environments), with periodic deterministic evaluation,
+//! atomic checkpoints, and a result folder:
+//!
+//! - `manifest.json`: env spec and hash, algorithm, configuration, seed, samples, code version,
+//!   machine, wall time;
+//! - `curve.csv`, `curve.png`, `drag_reduction.png`: the learning curve;
+//! - `policy.json`: the final deterministic policy (`hgym eval --policy DIR` loads it);
+//! - `metrics.json`: the final evaluation ([`eval::EvalReport`]);
+//! - `checkpoint.bin`: everything needed to continue (`--resume DIR`): a resumed run reaches the
+//!   same policy and metrics as an uninterrupted one, bitwise, because rounds reset their
+//!   environments from seeds derived from (seed, round) and the learner's state is complete.
+
+pub mod checkpoint;
+pub mod config;
+pub mod curve;
+pub mod eval;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use hgym_agents::learn::{Algo, Learner};
+use hgym_agents::EnvError;
+use serde::{Deserialize, Serialize};
+
+use self::checkpoint::Checkpoint;
+use self::config::{override_spec, TrainConfig};
+use self::curve::CurveRow;
+use self::eval::{evaluate, uncontrolled_c_d, EvalReport, Stat};
+use crate::env::{EnvSpec, LbmEnv};
+use crate::report::manifest::{manifest, Manifest};
+use crate::validate::case::Level;
+
+#[derive(Debug, thiserror::Error)]
+pub enum TrainError {
+    /// Bad input: an unknown ID, a bad configuration, a damaged checkpoint (exit code 2).
+    #[error("{0}")]
+    Input(String),
+    #[error(transparent)]
+    Env(#[from] EnvError),
+    #[error("{0}")]
+    Io(String),
+}
+
+/// What to train.
+#[derive(Clone, Debug)]
+pub struct TrainOptions {
+    pub env_id: String,
+    pub algo: Algo,
+    pub seed: u64,
+    pub level: Level,
+    pub config: TrainConfig,
+    pub out: PathBuf,
+    pub cache: Option<PathBuf>,
+}
+
+/// What the progress display sees after each round.
+#[derive(Clone, Debug)]
+pub struct Progress {
+    pub samples: u64,
+    pub total: u64,
+    pub round: u64,
+    pub train_return: f64,
+    pub train_c_d: f64,
+    pub last_eval: Option<(f64, f64)>,
+}
+
+/// How a run ended.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Ending {
+    Finished(Box<EvalReport>),
+    /// Stopped by the user (Ctrl-C) after a round; the checkpoint is current.
+    Interrupted {
+        samples: u64,
+    },
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct TrainManifest {
+    pub schema: String,
+    pub env_id: String,
+    pub spec_hash: String,
+    pub spec: EnvSpec,
+    pub level: String,
+    pub algo: String,
+    pub seed: u64,
+    pub samples: u64,
+    pub updates: u64,
+    pub rounds: u64,
+    pub resumed: u32,
+    /// The effective training configuration (as `--print-config` prints it).
+    pub config_toml: String,
+    pub manifest: Manifest,
+}
+
+/// The environment spec with the configuration's `[env]` overrides applied.
+pub fn resolve_spec(env_id: &str, config: &TrainConfig) -> Result<EnvSpec, TrainError> {
+    let spec = crate::env::spec(env_id).map_err(|e| TrainError::Input(e.to_string()))?;
+    match &config.env {
+        Some(over) => override_spec(&spec, over).map_err(TrainError::Input),
+        None => Ok(spec),
+    }
+}
+
+fn eval_seeds(config: &TrainConfig, n: usize) -> Vec<u64> {
+    (0..n as u64).map(|k| config.train.eval_seed + k).collect()
+}
+
+/// Trains from scratch (or continues from `resume`), calling `progress` after every round and
+/// stopping cleanly after the current round when `interrupted()` turns true.
+pub fn train(
+    opts: &TrainOptions,
+    resume: Option<Checkpoint>,
+    progress: &mut dyn FnMut(&Progress),
+    interrupted: &dyn Fn() -> bool,
+) -> Result<Ending, TrainError> {
+    let started = Instant::now();
+    let config = &opts.config;
+    let spec = resolve_spec(&opts.env_id, config)?;
+    let (obs_dim, act_dim) = (spec.obs_dim(), spec.act_dim());
+    let algos = config.algos();
+    let n_envs = algos.n_envs(opts.algo);
+    std::fs::create_dir_all(&opts.out).map_err(|e| TrainError::Io(format!("cannot create {}: {e}", opts.out.display())))?;
+    let make = || LbmEnv::new(spec.clone(), opts.level, opts.cache.clone());
+    let mut envs: Vec<LbmEnv> = (0..n_envs).map(|_| make()).collect::<Result<_, _>>()?;
+    let mut eval_env = make()?;
+    let periodic_seeds = eval_seeds(config, config.train.eval_episodes.max(1));
+
+    let (mut learner, mut curve, reference, wall_before, resumed) = match resume {
+        Some(ck) => {
+            let learner = Learner::from_bytes(&ck.learner).map_err(|e| TrainError::Input(e.to_string()))?;
+            (learner, ck.curve, ck.reference, ck.wall_s, ck.resumed + 1)
+        }
+        None => {
+            let learner = Learner::new(opts.algo, &algos, obs_dim, act_dim, opts.seed);
+            let reference = uncontrolled_c_d(&mut eval_env, &periodic_seeds)?;
+            (learner, vec![], reference, 0.0, 0)
+        }
+    };
+    let config_toml = config.to_toml();
+    let checkpoint = |learner: &Learner, curve: &[CurveRow], wall_s: f64| {
+        checkpoint::save(
+            &opts.out,
+            &Checkpoint {
+                format: checkpoint::FORMAT,
+                env_id: opts.env_id.clone(),
+                algo: opts.algo,
+                seed: opts.seed,
+                level: opts.level,
+                config_toml: config_toml.clone(),
+                learner: learner.to_bytes(),
+                curve: curve.to_vec(),
+                reference: reference.clone(),
+                wall_s,
+                resumed,
+            },
+        )
+        .map_err(TrainError::Io)
+    };
+    let mut last_ckpt = Instant::now();
+    let mut last_eval = curve
+        .iter()
+        .rev()
+        .find(|r| r.eval_return.is_finite())
+        .map(|r| (r.eval_return, r.eval_drag_reduction_pct));
+    while learner.samples() < config.train.steps {
+        if interrupted() {
+            checkpoint(&learner, &curve, wall_before + started.elapsed().as_secs_f64())?;
+            return Ok(Ending::Interrupted {
+                samples: learner.samples(),
+            });
+        }
+        let stats = learner.round(&mut envs)?;
+        let n = stats.len().max(1) as f64;
+        let mut row = CurveRow {
+            round: learner.rounds(),
+            samples: learner.samples(),
+            updates: learner.updates(),
+            wall_s: wall_before + started.elapsed().as_secs_f64(),
+            train_return: stats.iter().map(|s| s.ret).sum::<f64>() / n,
+            train_c_d: stats
+                .iter()
+                .map(|s| s.info_means.get("C_D").copied().unwrap_or(f64::NAN))
+                .sum::<f64>()
+                / n,
+            eval_return: f64::NAN,
+            eval_c_d: f64::NAN,
+            eval_drag_reduction_pct: f64::NAN,
+        };
+        let every = config.train.eval_every;
+        if every > 0 && learner.rounds().is_multiple_of(every) {
+            let mut policy = learner.policy();
+            let hash = spec.hash();
+            let r = evaluate(
+                &mut eval_env,
+                &mut policy,
+                opts.algo.name(),
+                &spec.id,
+                &hash,
+                opts.level.name(),
+                &periodic_seeds,
+                &reference,
+                &mut |_| {},
+            )?;
+            row.eval_return = r.ret.mean;
+            row.eval_c_d = r.mean_c_d.mean;
+            row.eval_drag_reduction_pct = r.drag_reduction_pct.mean;
+            last_eval = Some((r.ret.mean, r.drag_reduction_pct.mean));
+        }
+        progress(&Progress {
+            samples: row.samples,
+            total: config.train.steps,
+            round: row.round,
+            train_return: row.train_return,
+            train_c_d: row.train_c_d,
+            last_eval,
+        });
+        curve.push(row);
+        if last_ckpt.elapsed().as_secs_f64() >= config.train.checkpoint_seconds {
+            checkpoint(&learner, &curve, wall_before + started.elapsed().as_secs_f64())?;
+            last_ckpt = Instant::now();
+        }
+    }
+    let wall = wall_before + started.elapsed().as_secs_f64();
+    checkpoint(&learner, &curve, wall)?;
+
+    // Final evaluation on its own seeds, against the uncontrolled flow from the same states.
+    let final_seeds = eval_seeds(config, config.train.final_eval_episodes.max(1));
+    let final_ref = uncontrolled_c_d(&mut eval_env, &final_seeds)?;
+    let mut policy = learner.policy();
+    let hash = spec.hash();
+    let report = evaluate(
+        &mut eval_env,
+        &mut policy,
+        opts.algo.name(),
+        &spec.id,
+        &hash,
+        opts.level.name(),
+        &final_seeds,
+        &final_ref,
+        &mut |_| {},
+    )?;
+    let io = |e: std::io::Error| TrainError::Io(format!("writing results to {}: {e}", opts.out.display()));
+    let json = |v: &dyn erased::Json| v.to_json();
+    std::fs::write(opts.out.join("policy.json"), json(&policy) + "\n").map_err(io)?;
+    std::fs::write(opts.out.join("metrics.json"), json(&report) + "\n").map_err(io)?;
+    std::fs::write(opts.out.join("curve.csv"), curve::to_csv(&curve)).map_err(io)?;
+    let title = format!("{} {} seed {} ({})", spec.id, opts.algo.name(), opts.seed, opts.level.name());
+    curve::plot(&opts.out, &title, &curve).map_err(TrainError::Io)?;
+    let m = TrainManifest {
+        schema: "hgym/train/v1".into(),
+        env_id: spec.id.clone(),
+        spec_hash: hash,
+        spec: spec.clone(),
+        level: opts.level.name().into(),
+        algo: opts.algo.name().into(),
+        seed: opts.seed,
+        samples: learner.samples(),
+        updates: learner.updates(),
+        rounds: learner.rounds(),
+        resumed,
+        config_toml,
+        manifest: manifest(rayon::current_num_threads(), wall),
+    };
+    std::fs::write(opts.out.join("manifest.json"), json(&m) + "\n").map_err(io)?;
+    Ok(Ending::Finished(Box::new(report)))
+}
+
+/// Options stored in a checkpoint, for `--resume DIR` (the step budget may be raised).
+pub fn resume_options(dir: &Path, steps: Option<u64>, cache: Option<PathBuf>) -> Result<(TrainOptions, Checkpoint), TrainError> {
+    let ck = checkpoint::load(dir).map_err(TrainError::Input)?;
+    let mut config = TrainConfig::parse(&ck.config_toml, "checkpoint").map_err(TrainError::Input)?;
+    if let Some(s) = steps {
+        config.train.steps = s;
+    }
+    Ok((
+        TrainOptions {
+            env_id: ck.env_id.clone(),
+            algo: ck.algo,
+            seed: ck.seed,
+            level: ck.level,
+            config,
+            out: dir.to_path_buf(),
+            cache,
+        },
+        ck,
+    ))
+}
+
+/// Summary over the seeds of one (env, algorithm): mean and std over seeds of the per-seed
+/// evaluation means.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct SeedSummary {
+    pub schema: String,
+    pub env_id: String,
+    pub algo: String,
+    pub level: String,
+    pub seeds: Vec<u64>,
+    pub drag_reduction_pct: Stat,
+    pub ret: Stat,
+    pub mean_c_d: Stat,
+    pub runs: Vec<PathBuf>,
+}
+
+pub fn summarize(env_id: &str, algo: &str, level: &str, runs: &[(u64, PathBuf, EvalReport)]) -> SeedSummary {
+    let col = |f: fn(&EvalReport) -> f64| Stat::of(&runs.iter().map(|(_, _, r)| f(r)).collect::<Vec<_>>());
+    SeedSummary {
+        schema: "hgym/seeds/v1".into(),
+        env_id: env_id.into(),
+        algo: algo.into(),
+        level: level.into(),
+        seeds: runs.iter().map(|(s, _, _)| *s).collect(),
+        drag_reduction_pct: col(|r| r.drag_reduction_pct.mean),
+        ret: col(|r| r.ret.mean),
+        mean_c_d: col(|r| r.mean_c_d.mean),
+        runs: runs.iter().map(|(_, p, _)| p.clone()).collect(),
+    }
+}
+
+mod erased {
+    /// Pretty JSON of any serialisable value (NaN becomes null).
+    pub trait Json {
+        fn to_json(&self) -> String;
+    }
+    impl<T: serde::Serialize> Json for T {
+        fn to_json(&self) -> String {
+            serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+        }
+    }
+}

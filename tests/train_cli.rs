@@ -1,0 +1,214 @@
+//! `hgym train` / `hgym eval` on a real flow (Cylinder_2D_Re100 at the coarse level, a few
+//! rounds with small networks): result folder, Ctrl-C leaves a checkpoint, `--resume` reaches the
+//! uninterrupted result bitwise, baselines evaluate, size mismatches are refused clearly.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn hgym(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hgym")).args(args).output().expect("run hgym")
+}
+
+fn text(o: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+/// Small networks, early learning, one evaluation episode: ~2 s per round of 2 x 200 actions.
+const CONFIG: &str = "[train]\neval_every = 2\neval_episodes = 1\nfinal_eval_episodes = 1\ncheckpoint_seconds = 1000.0\n\
+                      [td3]\nhidden = [32, 32]\nbatch_size = 32\nlearning_starts = 200\n";
+
+fn config(dir: &Path) -> PathBuf {
+    let p = dir.join("small.toml");
+    std::fs::write(&p, CONFIG).unwrap();
+    p
+}
+
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+#[test]
+fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = config(tmp.path());
+    let cfg = cfg.to_str().unwrap();
+    // Uninterrupted: 4 rounds (1600 samples).
+    let full = tmp.path().join("full");
+    let o = hgym(&[
+        "train",
+        "--env",
+        "Cylinder_2D_Re100",
+        "--algo",
+        "td3",
+        "--steps",
+        "1600",
+        "--config",
+        cfg,
+        "--out",
+        full.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let run = full.join("Cylinder_2D_Re100-td3-coarse/seed0");
+    for f in [
+        "manifest.json",
+        "metrics.json",
+        "policy.json",
+        "curve.csv",
+        "curve.png",
+        "drag_reduction.png",
+        "checkpoint.bin",
+    ] {
+        assert!(run.join(f).exists(), "missing {f}");
+    }
+    let curve = read(&run.join("curve.csv"));
+    assert_eq!(curve.lines().count(), 5, "{curve}");
+    let metrics: serde_json::Value = serde_json::from_str(&read(&run.join("metrics.json"))).unwrap();
+    assert!(metrics["drag_reduction_pct"]["mean"].as_f64().unwrap().is_finite());
+    let manifest: serde_json::Value = serde_json::from_str(&read(&run.join("manifest.json"))).unwrap();
+    assert_eq!(manifest["samples"], 1600);
+    assert_eq!(manifest["algo"], "td3");
+
+    // Interrupted with SIGINT (Ctrl-C) during the run, then resumed.
+    let cut = tmp.path().join("cut");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hgym"))
+        .args([
+            "train",
+            "--env",
+            "Cylinder_2D_Re100",
+            "--algo",
+            "td3",
+            "--steps",
+            "1600",
+            "--config",
+            cfg,
+            "--out",
+            cut.to_str().unwrap(),
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(3500));
+    let _ = Command::new("kill").args(["-INT", &child.id().to_string()]).status();
+    let t0 = Instant::now();
+    let status = child.wait().unwrap();
+    let cut_run = cut.join("Cylinder_2D_Re100-td3-coarse/seed0");
+    let mut err = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        use std::io::Read;
+        let _ = e.read_to_string(&mut err);
+    }
+    if status.code() == Some(130) {
+        assert!(err.contains("--resume"), "the interrupt message names the way back: {err}");
+        assert!(cut_run.join("checkpoint.bin").exists());
+        assert!(!cut_run.join("policy.json").exists(), "an interrupted run has no final policy");
+        println!("interrupted after {:.1} s, stopped {:.1} s later", 3.5, t0.elapsed().as_secs_f64());
+        let o = hgym(&["train", "--resume", cut_run.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", text(&o));
+    } else {
+        // The machine was fast enough to finish before the signal: still a complete result.
+        assert!(status.success(), "{err}");
+    }
+    assert_eq!(
+        read(&cut_run.join("policy.json")),
+        read(&run.join("policy.json")),
+        "resumed policy differs"
+    );
+    assert_eq!(
+        read(&cut_run.join("metrics.json")),
+        read(&run.join("metrics.json")),
+        "resumed metrics differ"
+    );
+    assert_eq!(read(&cut_run.join("curve.csv")).lines().count(), 5);
+
+    // The trained policy evaluates through `hgym eval`, and is refused on a flow of another shape.
+    let o = hgym(&[
+        "eval",
+        "--policy",
+        run.to_str().unwrap(),
+        "--env",
+        "Cylinder_2D_Re100",
+        "--episodes",
+        "1",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        r["mean_c_d"]["mean"], metrics["mean_c_d"]["mean"],
+        "eval reproduces train's final evaluation"
+    );
+    let o = hgym(&[
+        "eval",
+        "--policy",
+        run.to_str().unwrap(),
+        "--env",
+        "Pinball_2D_Re30",
+        "--episodes",
+        "1",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let t = text(&o);
+    assert!(t.contains("1 action") || t.contains("to 1 actions"), "{t}");
+    assert!(t.contains("3 actions"), "{t}");
+}
+
+#[test]
+fn baselines_evaluate_against_the_uncontrolled_flow() {
+    let o = hgym(&[
+        "eval",
+        "--policy",
+        "zero",
+        "--env",
+        "Cylinder_2D_Re100",
+        "--episodes",
+        "1",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        r["drag_reduction_pct"]["mean"].as_f64(),
+        Some(0.0),
+        "zero control is the reference itself"
+    );
+    assert_eq!(r["actuation_cost"]["mean"].as_f64(), Some(0.0));
+    let o = hgym(&[
+        "eval",
+        "--policy",
+        "opposition=2",
+        "--env",
+        "Cylinder_2D_Re100",
+        "--episodes",
+        "1",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(r["actuation_cost"]["mean"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn bad_training_input_is_named() {
+    let o = hgym(&["train", "--env", "Cylindre_2D_Re100", "--steps", "10"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).contains("Cylinder_2D_Re100"), "{}", text(&o));
+    let tmp = tempfile::tempdir().unwrap();
+    let p = tmp.path().join("bad.toml");
+    std::fs::write(&p, "[td3]\nbatchsize = 3\n").unwrap();
+    let o = hgym(&["train", "--env", "Cylinder_2D_Re100", "--config", p.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).contains("batchsize"), "{}", text(&o));
+    let o = hgym(&["train", "--env", "Cylinder_2D_Re100", "--seeds", "3..1"]);
+    assert_eq!(o.status.code(), Some(2));
+    let o = hgym(&["eval", "--policy", "bogus", "--env", "Cylinder_2D_Re100"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).contains("opposition"), "{}", text(&o));
+    let o = hgym(&["train", "--resume", tmp.path().to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).contains("checkpoint"), "{}", text(&o));
+    let o = hgym(&["train", "--print-config"]);
+    assert!(o.status.success());
+    assert!(text(&o).contains("[td3]") && text(&o).contains("policy_delay"));
+}
