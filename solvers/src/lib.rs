@@ -18,3 +18,4 @@
 
 pub mod geometry;
 pub mod lbm;
+pub mod spectral;
