@@ -61,6 +61,9 @@ enum Command {
     /// Evaluate a trained policy or a classical baseline: return, C_D, drag reduction against the
     /// uncontrolled flow from the same initial states, |C_L|, actuation cost (mean +- std).
     Eval(cli::train::EvalArgs),
+    /// Run a comparison protocol (benchmarks/protocols/*.toml): several algorithms over the same
+    /// seeds, and the samples each needs to reach a fraction of the reference's final return.
+    Compare(cli::train::CompareArgs),
 }
 
 #[derive(Args)]
@@ -209,6 +212,7 @@ fn main() -> ExitCode {
         Command::Run(args) => run_rollout(args),
         Command::Train(args) => cli::train::run_train(args),
         Command::Eval(args) => cli::train::run_eval(args),
+        Command::Compare(args) => cli::train::run_compare(args),
         Command::Bench(BenchCommand::Agents { json, quick, threads }) => cli::train::run_bench_agents(json, quick, threads),
     };
     match result {
@@ -338,15 +342,25 @@ fn run_bench(json: bool, quick: bool, collision: CollisionArg) -> Result<Outcome
 fn run_envs(args: EnvsArgs) -> Result<Outcome> {
     match args.command {
         None => {
-            let specs = hgym::env::registry::all();
+            let specs = hgym::env::any::all();
+            let calibrated = |s: &hgym::env::any::AnySpec| match s {
+                hgym::env::any::AnySpec::Lbm(s) => !s.normalization.mean.is_empty(),
+                hgym::env::any::AnySpec::Kolmogorov(s) => s.statistics.u_rms > 0.0,
+            };
+            let validation = |s: &hgym::env::any::AnySpec| match s.family() {
+                "cylinder" | "rotary_cylinder" if s.reynolds() <= 200.0 => "cylinder (pass)",
+                "kolmogorov" if s.reynolds() <= 40.0 => "kolmogorov (bursts)",
+                _ => "-",
+            };
             if args.json {
                 let rows: Vec<serde_json::Value> = specs
                     .iter()
                     .map(|s| {
                         serde_json::json!({
-                            "id": s.id, "family": s.family, "dimension": 2, "reynolds": s.reynolds,
-                            "observations": s.obs_dim(), "actions": s.act_dim(), "solver": "lbm-d2q9",
-                            "calibrated": !s.normalization.mean.is_empty(), "spec_hash": s.hash(),
+                            "id": s.id(), "family": s.family(), "dimension": 2, "reynolds": s.reynolds(),
+                            "observations": s.obs_dim(), "actions": s.act_dim(), "solver": s.solver(),
+                            "differentiable": s.differentiable(),
+                            "calibrated": calibrated(s), "spec_hash": s.hash(),
                         })
                     })
                     .collect();
@@ -357,34 +371,60 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
                     "ID", "dim", "Re", "obs", "act", "solver", "calibrated"
                 );
                 for s in &specs {
-                    let validation = if s.family == "cylinder" || s.family == "rotary_cylinder" {
-                        if s.reynolds <= 200.0 {
-                            "cylinder (pass)"
-                        } else {
-                            "-"
-                        }
-                    } else {
-                        "-"
-                    };
                     println!(
                         "{:<26} {:>3} {:>7} {:>5} {:>5} {:<10} {:<10} {}",
-                        s.id,
+                        s.id(),
                         "2D",
-                        s.reynolds,
+                        s.reynolds(),
                         s.obs_dim(),
                         s.act_dim(),
-                        "lbm-d2q9",
-                        if s.normalization.mean.is_empty() { "no" } else { "yes" },
-                        validation
+                        s.solver(),
+                        if calibrated(s) { "yes" } else { "no" },
+                        validation(s)
                     );
                 }
             }
             Ok(Outcome::Ok)
         }
         Some(EnvsCommand::Show { id }) => {
-            let spec = hgym::env::spec(&id)?;
-            println!("# {} (spec hash {})", spec.id, spec.hash());
+            let spec = hgym::env::any::lookup(&id)?;
+            println!("# {} (spec hash {})", spec.id(), spec.hash());
             print!("{}", spec.to_toml());
+            Ok(Outcome::Ok)
+        }
+        Some(EnvsCommand::Calibrate {
+            id,
+            level,
+            actions,
+            table: _,
+            threads: _,
+        }) if id.starts_with("Kolmogorov") => {
+            let hgym::env::any::AnySpec::Kolmogorov(spec) = hgym::env::any::lookup(&id)? else {
+                return Err(UsageError(format!("{id} is not a Kolmogorov flow")).into());
+            };
+            let table = PathBuf::from("benchmarks/envs/kolmogorov.toml");
+            let text = std::fs::read_to_string(&table)
+                .with_context(|| format!("cannot read {} (run from the repository root)", table.display()))?;
+            let mut entries: std::collections::BTreeMap<String, hgym::env::kolmogorov::FlowStatistics> =
+                toml::from_str(&text).with_context(|| format!("{} is malformed", table.display()))?;
+            let pb = progress_bar(actions as u64, &id);
+            let st = hgym::env::kolmogorov::calibrate(&spec, level, actions, &mut |k| pb.set_position(k as u64))
+                .with_context(|| format!("calibrating {id}"))?;
+            pb.finish_and_clear();
+            println!(
+                "{id}: u_rms {:.4}, dissipation {:.4} +- {:.4} (laminar {:.4}), TKE {:.4} over {} time units",
+                st.u_rms,
+                st.dissipation_mean,
+                st.dissipation_std,
+                spec.dissipation_laminar(),
+                st.tke_mean,
+                st.time
+            );
+            entries.insert(id.clone(), st);
+            let header: String = text.lines().take_while(|l| l.starts_with('#')).map(|l| format!("{l}\n")).collect();
+            let body = toml::to_string_pretty(&entries).context("cannot format the table")?;
+            std::fs::write(&table, format!("{header}\n{body}")).with_context(|| format!("cannot write {}", table.display()))?;
+            println!("wrote {} (rebuild to embed)", table.display());
             Ok(Outcome::Ok)
         }
         Some(EnvsCommand::Calibrate {

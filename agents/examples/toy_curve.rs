@@ -10,6 +10,7 @@ fn main() {
     let algo = match args.get(1).map(|s| s.as_str()) {
         Some("ppo") => Algo::Ppo,
         Some("ddpg") => Algo::Ddpg,
+        Some("gppo") => Algo::Gppo,
         _ => Algo::Td3,
     };
     let rounds: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(100);

@@ -66,3 +66,14 @@ pub trait Env {
     /// Applies one action for one control interval.
     fn step(&mut self, action: &[f64]) -> Result<StepResult, EnvError>;
 }
+
+/// The differentiable extension of the contract (the paper's JAX environments): the env keeps
+/// its trajectory since the last reset and differentiates through it with vector-Jacobian
+/// products of its steps (a discrete adjoint), not finite differences.
+pub trait DifferentiableEnv: Env {
+    /// For the last `k` steps (the segment `T-k+1..T`), the gradient of the segment's summed
+    /// reward with respect to each step's action (in normalised action units, at the action
+    /// the env applied after clipping), holding the other actions fixed: `out[j]` belongs to
+    /// step `T-k+1+j`. One backward sweep over the segment.
+    fn reward_action_gradients(&mut self, k: usize) -> Result<Vec<Vec<f64>>, EnvError>;
+}

@@ -7,7 +7,8 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::ddpg::{ddpg, DdpgConfig};
-use crate::env::{Env, EnvError};
+use crate::env::{DifferentiableEnv, EnvError};
+use crate::gppo::{Gppo, GppoConfig};
 use crate::policy::ActorPolicy;
 use crate::ppo::{Ppo, PpoConfig};
 use crate::rollout::EpisodeStats;
@@ -20,11 +21,13 @@ pub enum Algo {
     Ppo,
     Ddpg,
     Td3,
+    Gppo,
 }
 
 impl Algo {
     pub fn name(self) -> &'static str {
         match self {
+            Algo::Gppo => "gppo",
             Algo::Ppo => "ppo",
             Algo::Ddpg => "ddpg",
             Algo::Td3 => "td3",
@@ -39,12 +42,13 @@ pub struct AlgoConfigs {
     pub ppo: PpoConfig,
     pub ddpg: DdpgConfig,
     pub td3: Td3Config,
+    pub gppo: GppoConfig,
 }
 
 impl AlgoConfigs {
     pub fn n_envs(&self, algo: Algo) -> usize {
         match algo {
-            Algo::Ppo => self.ppo.n_envs,
+            Algo::Ppo | Algo::Gppo => self.ppo.n_envs,
             Algo::Ddpg => self.ddpg.n_envs,
             Algo::Td3 => self.td3.n_envs,
         }
@@ -64,6 +68,7 @@ pub enum LearnError {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub enum Learner {
     Ppo(Box<Ppo>),
+    Gppo(Box<Gppo>),
     OffPolicy(Box<Td3>),
 }
 
@@ -71,15 +76,18 @@ impl Learner {
     pub fn new(algo: Algo, cfg: &AlgoConfigs, obs_dim: usize, act_dim: usize, seed: u64) -> Self {
         match algo {
             Algo::Ppo => Learner::Ppo(Box::new(Ppo::new(cfg.ppo.clone(), obs_dim, act_dim, seed))),
+            Algo::Gppo => Learner::Gppo(Box::new(Gppo::new(cfg.ppo.clone(), cfg.gppo.clone(), obs_dim, act_dim, seed))),
             Algo::Ddpg => Learner::OffPolicy(Box::new(ddpg(&cfg.ddpg, obs_dim, act_dim, seed))),
             Algo::Td3 => Learner::OffPolicy(Box::new(Td3::new("td3", cfg.td3.clone(), obs_dim, act_dim, seed))),
         }
     }
 
-    /// One episode on every environment and the updates that go with it.
-    pub fn round<E: Env + Send>(&mut self, envs: &mut [E]) -> Result<Vec<EpisodeStats>, EnvError> {
+    /// One episode on every environment and the updates that go with it (GPPO differentiates
+    /// through the environments; the others only step them).
+    pub fn round<E: DifferentiableEnv + Send>(&mut self, envs: &mut [E]) -> Result<Vec<EpisodeStats>, EnvError> {
         match self {
             Learner::Ppo(p) => p.round(envs),
+            Learner::Gppo(g) => g.round(envs),
             Learner::OffPolicy(t) => t.round(envs),
         }
     }
@@ -88,6 +96,7 @@ impl Learner {
     pub fn policy(&self) -> ActorPolicy {
         match self {
             Learner::Ppo(p) => p.policy(),
+            Learner::Gppo(g) => g.ppo.policy(),
             Learner::OffPolicy(t) => t.policy(),
         }
     }
@@ -96,6 +105,7 @@ impl Learner {
     pub fn samples(&self) -> u64 {
         match self {
             Learner::Ppo(p) => p.samples,
+            Learner::Gppo(g) => g.ppo.samples,
             Learner::OffPolicy(t) => t.samples,
         }
     }
@@ -104,6 +114,7 @@ impl Learner {
     pub fn updates(&self) -> u64 {
         match self {
             Learner::Ppo(p) => p.updates,
+            Learner::Gppo(g) => g.ppo.updates,
             Learner::OffPolicy(t) => t.updates,
         }
     }
@@ -112,6 +123,7 @@ impl Learner {
     pub fn rounds(&self) -> u64 {
         match self {
             Learner::Ppo(p) => p.round,
+            Learner::Gppo(g) => g.ppo.round,
             Learner::OffPolicy(t) => t.round,
         }
     }

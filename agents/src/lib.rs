@@ -15,6 +15,7 @@ pub mod baselines;
 pub mod buffer;
 pub mod ddpg;
 mod env;
+pub mod gppo;
 pub mod learn;
 pub mod nn;
 pub mod noise;
@@ -27,5 +28,5 @@ mod spaces;
 pub mod td3;
 pub mod toy;
 
-pub use env::{Env, EnvError, Info, StepResult};
+pub use env::{DifferentiableEnv, Env, EnvError, Info, StepResult};
 pub use spaces::BoxSpace;

@@ -10,6 +10,7 @@
 //! parallel. A truncated episode is bootstrapped with `gamma V(s_T)` (as SB3 does), a
 //! terminated one is not.
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::env::{Env, EnvError};
@@ -90,6 +91,8 @@ pub struct Sample {
     pub reward: f64,
     pub advantage: f64,
     pub ret: f64,
+    /// GPPO: gradient of the reward (over the env's segment) with respect to the applied action.
+    pub action_grad: Option<Vec<f64>>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -110,6 +113,9 @@ pub struct Ppo {
     pub samples: u64,
     pub updates: u64,
     pub round: u64,
+    /// Weight of the analytic reward gradient in the policy loss (0 for PPO; GPPO sets it).
+    #[serde(default)]
+    pub analytic_weight: f64,
     #[serde(skip)]
     scratch: Scratch,
 }
@@ -155,6 +161,7 @@ impl Ppo {
             samples: 0,
             updates: 0,
             round: 0,
+            analytic_weight: 0.0,
             cfg,
             scratch: Scratch::default(),
         }
@@ -185,6 +192,17 @@ impl Ppo {
 
     /// One round: an episode per environment, then `n_epochs` of minibatch updates.
     pub fn round<E: Env + Send>(&mut self, envs: &mut [E]) -> Result<Vec<EpisodeStats>, EnvError> {
+        self.round_with(envs, 0, &|_: &mut E, _| Ok(vec![]))
+    }
+
+    /// A round in which, when `segment > 0`, every `segment` actions of an environment (and at
+    /// its episode's end) `gradients(env, k)` returns the reward gradients with respect to its
+    /// last `k` actions (GPPO); they are stored on the samples for [`Ppo::update`].
+    pub fn round_with<E, G>(&mut self, envs: &mut [E], segment: usize, gradients: &G) -> Result<Vec<EpisodeStats>, EnvError>
+    where
+        E: Env + Send,
+        G: Fn(&mut E, usize) -> Result<Vec<Vec<f64>>, EnvError> + Sync,
+    {
         let n = envs.len();
         if self.reward_scaler.returns.len() < n {
             self.reward_scaler.returns.resize(n, 0.0);
@@ -199,6 +217,7 @@ impl Ppo {
         let mut acc = vec![EpisodeAccumulator::default(); n];
         let mut trajectories: Vec<Vec<Sample>> = vec![vec![]; n];
         let mut pending: Vec<Option<Sample>> = vec![None; n];
+        let mut want = vec![0usize; n];
         while active.iter().any(|a| *a) {
             for i in 0..n {
                 if !active[i] {
@@ -222,6 +241,7 @@ impl Ppo {
                     reward: 0.0,
                     advantage: 0.0,
                     ret: 0.0,
+                    action_grad: None,
                 });
             }
             let results = step_all(envs, &actions, &active)?;
@@ -244,6 +264,28 @@ impl Ppo {
                 obs[i] = next;
                 if done {
                     active[i] = false;
+                }
+                if segment > 0 {
+                    let since = trajectories[i].iter().rev().take_while(|s| s.action_grad.is_none()).count();
+                    if since >= segment || done {
+                        want[i] = since;
+                    }
+                }
+            }
+            if want.iter().any(|k| *k > 0) {
+                let grads: Vec<Option<Vec<Vec<f64>>>> = envs
+                    .par_iter_mut()
+                    .zip(want.par_iter())
+                    .map(|(e, k)| if *k > 0 { gradients(e, *k).map(Some) } else { Ok(None) })
+                    .collect::<Result<_, _>>()?;
+                for (i, g) in grads.into_iter().enumerate() {
+                    if let Some(g) = g {
+                        let len = trajectories[i].len();
+                        for (s, gj) in trajectories[i][len - g.len()..].iter_mut().zip(g) {
+                            s.action_grad = Some(gj);
+                        }
+                    }
+                    want[i] = 0;
                 }
             }
         }
@@ -276,6 +318,20 @@ impl Ppo {
         s.actor_grad.resize(self.actor.params.len(), 0.0);
         s.critic_grad.resize(self.critic.params.len(), 0.0);
         s.log_std_grad.resize(a, 0.0);
+        // GPPO: analytic gradients scaled to unit RMS over the rollout, so that the weight is
+        // dimensionless (an adaptive coefficient on the gradient's magnitude).
+        let g_rms = {
+            let (sum, count) = samples
+                .iter()
+                .filter_map(|s| s.action_grad.as_ref())
+                .flat_map(|g| g.iter())
+                .fold((0.0, 0usize), |(s, c), g| (s + g * g, c + 1));
+            if count > 0 {
+                (sum / count as f64).sqrt().max(1e-12)
+            } else {
+                1.0
+            }
+        };
         for _ in 0..self.cfg.n_epochs {
             // Fisher-Yates with the learner's generator.
             for i in (1..n).rev() {
@@ -317,7 +373,14 @@ impl Ppo {
                         let ls = self.log_std[j] as f64;
                         let sig = ls.exp();
                         let z = (smp.action[j] - mu[r * a + j] as f64) / sig;
-                        s.dmu[r * a + j] = (g * z / sig) as f32;
+                        let mut dmu = g * z / sig;
+                        // GPPO: L -= w mean(g_hat . mu); through clip(a) only inside [-1, 1].
+                        if let Some(ga) = &smp.action_grad {
+                            if smp.action[j].abs() <= 1.0 {
+                                dmu -= self.analytic_weight * ga[j] / g_rms / b as f64;
+                            }
+                        }
+                        s.dmu[r * a + j] = dmu as f32;
                         s.log_std_grad[j] += (g * (z * z - 1.0)) as f32;
                     }
                 }

@@ -97,6 +97,12 @@ fn ppo_stabilises_the_oscillator() {
     check(Algo::Ppo, 60);
 }
 
+/// GPPO differentiates through the oscillator (its adjoint is exact) and must learn it too.
+#[test]
+fn gppo_stabilises_the_oscillator() {
+    check(Algo::Gppo, 60);
+}
+
 /// Kill after K rounds (checkpoint bytes), resume, finish: the same learner, bitwise.
 #[test]
 fn resume_is_bitwise_identical() {

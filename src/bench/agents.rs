@@ -75,6 +75,7 @@ pub fn bench_agents(quick: bool) -> AgentsBench {
                 reward: rng.normal(),
                 advantage: rng.normal(),
                 ret: rng.normal(),
+                action_grad: None,
             }
         })
         .collect();

@@ -5,7 +5,6 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use anyhow::{Context, Result};
 use clap::Args;
-use hgym::env::LbmEnv;
 use hgym::train::config::TrainConfig;
 use hgym::train::eval::{evaluate, parse_policy, uncontrolled_c_d, EvalReport, NamedPolicy};
 use hgym::train::{resolve_spec, resume_options, summarize, Ending, TrainError, TrainOptions};
@@ -21,6 +20,8 @@ pub enum AlgoArg {
     Ppo,
     Ddpg,
     Td3,
+    /// PPO plus the analytic reward gradient through a differentiable env (Kolmogorov flows).
+    Gppo,
 }
 
 impl From<AlgoArg> for Algo {
@@ -29,6 +30,7 @@ impl From<AlgoArg> for Algo {
             AlgoArg::Ppo => Algo::Ppo,
             AlgoArg::Ddpg => Algo::Ddpg,
             AlgoArg::Td3 => Algo::Td3,
+            AlgoArg::Gppo => Algo::Gppo,
         }
     }
 }
@@ -176,7 +178,15 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
     } else {
         let env_id = args.env.clone().unwrap_or_default();
         let algo: Algo = args.algo.into();
-        resolve_spec(&env_id, &config).map_err(train_error)?;
+        let spec = resolve_spec(&env_id, &config).map_err(train_error)?;
+        if algo == Algo::Gppo && !spec.differentiable() {
+            return Err(UsageError(format!(
+                "gppo needs a differentiable environment (the Kolmogorov flows, e.g. Kolmogorov_2D_Re40); \
+                 {env_id} runs on the {} solver, which has no adjoint: use ppo, ddpg or td3",
+                spec.solver()
+            ))
+            .into());
+        }
         let seeds = match &args.seeds {
             Some(s) => parse_seeds(s)?,
             None => vec![args.seed],
@@ -216,9 +226,20 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
                         pb.set_position(p.samples.min(p.total));
                         let eval = p
                             .last_eval
-                            .map(|(r, dr)| format!(" | eval return {r:.1}, drag reduction {dr:+.1}%"))
+                            .map(|(r, dr)| {
+                                if dr.is_finite() {
+                                    format!(" | eval return {r:.1}, drag reduction {dr:+.1}%")
+                                } else {
+                                    format!(" | eval return {r:.2}")
+                                }
+                            })
                             .unwrap_or_default();
-                        pb.set_message(format!("{label} return {:.1} C_D {:.3}{eval}", p.train_return, p.train_c_d));
+                        let c_d = if p.train_c_d.is_finite() {
+                            format!(" C_D {:.3}", p.train_c_d)
+                        } else {
+                            String::new()
+                        };
+                        pb.set_message(format!("{label} return {:.1}{c_d}{eval}", p.train_return));
                         if !pb.is_hidden() {
                             return;
                         }
@@ -244,7 +265,18 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
                 std::process::exit(130);
             }
             Ending::Finished(report) => {
-                if !args.json {
+                if !args.json && !report.drag_reduction_pct.mean.is_finite() {
+                    println!(
+                        "{} {} seed {}: return {:.3} +- {:.3} over {} episodes\n  results: {}",
+                        opts.env_id,
+                        opts.algo.name(),
+                        opts.seed,
+                        report.ret.mean,
+                        report.ret.std,
+                        report.episodes.len(),
+                        opts.out.display()
+                    );
+                } else if !args.json {
                     println!(
                         "{} {} seed {}: drag reduction {:+.2} % +- {:.2} (C_D {:.4} vs {:.4} uncontrolled), return {:.2} +- {:.2} over {} episodes",
                         opts.env_id,
@@ -310,7 +342,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
                     args.policy,
                     p.obs_dim(),
                     p.act_dim(),
-                    spec.id,
+                    spec.id(),
                     spec.obs_dim(),
                     spec.act_dim()
                 ))
@@ -324,10 +356,10 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
     let (pool, threads) = thread_pool(args.threads)?;
     let started = std::time::Instant::now();
     let seeds: Vec<u64> = (0..args.episodes as u64).map(|k| args.eval_seed + k).collect();
-    let pb = progress_bar(2 * args.episodes as u64, &spec.id);
+    let pb = progress_bar(2 * args.episodes as u64, spec.id());
     let report: EvalReport = pool
         .install(|| -> Result<EvalReport> {
-            let mut env = LbmEnv::new(spec.clone(), args.level, hgym::env::default_cache_dir())?;
+            let mut env = spec.make(args.level, hgym::env::default_cache_dir())?;
             let reference = uncontrolled_c_d(&mut env, &seeds)?;
             pb.set_position(args.episodes as u64);
             let hash = spec.hash();
@@ -335,7 +367,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
                 &mut env,
                 policy.as_mut(),
                 &name,
-                &spec.id,
+                spec.id(),
                 &hash,
                 args.level.name(),
                 &seeds,
@@ -343,7 +375,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
                 &mut |k| pb.set_position((args.episodes + k) as u64),
             )?)
         })
-        .with_context(|| format!("evaluating {} on {}", args.policy, spec.id))?;
+        .with_context(|| format!("evaluating {} on {}", args.policy, spec.id()))?;
     pb.finish_and_clear();
     if let Some(out) = &args.out {
         let slug: String = args
@@ -351,13 +383,13 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
             .chars()
             .map(|c| if c.is_ascii_alphanumeric() || c == '.' { c } else { '_' })
             .collect();
-        let dir = out.join(format!("{}-{}-{}", spec.id, slug, args.level.name()));
+        let dir = out.join(format!("{}-{}-{}", spec.id(), slug, args.level.name()));
         std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
         std::fs::write(dir.join("metrics.json"), serde_json::to_string_pretty(&report)? + "\n")?;
         let m = hgym::report::manifest::manifest(threads, started.elapsed().as_secs_f64());
         let manifest = serde_json::json!({
             "schema": "hgym/eval-manifest/v1",
-            "env_id": spec.id,
+            "env_id": spec.id(),
             "spec_hash": spec.hash(),
             "spec": spec,
             "level": args.level.name(),
@@ -371,6 +403,18 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
+    } else if !report.mean_c_d.mean.is_finite() {
+        println!(
+            "{} on {} ({}, {} episodes)\n  return          {:10.3} +- {:.3}\n  actuation cost  {:10.4} +- {:.4}   (mean sum of squared actions)",
+            report.policy,
+            report.env_id,
+            report.level,
+            report.episodes.len(),
+            report.ret.mean,
+            report.ret.std,
+            report.actuation_cost.mean,
+            report.actuation_cost.std
+        );
     } else {
         println!(
             "{} on {} ({}, {} episodes)\n  return          {:10.3} +- {:.3}\n  mean C_D        {:10.4} +- {:.4}   (uncontrolled {:.4})\n  drag reduction  {:+9.2} % +- {:.2}\n  mean |C_L|      {:10.4} +- {:.4}\n  actuation cost  {:10.4} +- {:.4}   (mean sum of squared actions)",
@@ -407,4 +451,123 @@ pub fn run_bench_agents(json: bool, quick: bool, threads: Option<usize>) -> Resu
         print!("{}", hgym::bench::agents::table(&b));
     }
     Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
+}
+
+#[derive(Args)]
+pub struct CompareArgs {
+    /// A protocol file, e.g. benchmarks/protocols/kolmogorov_gppo.toml.
+    protocol: PathBuf,
+    /// Where the runs and the comparison go: <out>/<name>/<algo>/seed<S>/, comparison.json, learning_curves.png.
+    #[arg(long, default_value = "results/compare")]
+    out: PathBuf,
+    /// Only recompute the comparison from finished runs.
+    #[arg(long)]
+    analyse_only: bool,
+    #[arg(long)]
+    json: bool,
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+/// `hgym compare`: every (algorithm, seed) of a protocol, then samples-to-threshold.
+pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
+    use hgym::train::compare::{analyse, uncontrolled_return, Protocol};
+    let p = Protocol::load(&args.protocol).map_err(UsageError)?;
+    let spec = resolve_spec(&p.env, &p.config).map_err(train_error)?;
+    if p.algos.contains(&Algo::Gppo) && !spec.differentiable() {
+        return Err(UsageError(format!(
+            "{}: gppo needs a differentiable environment, {} is not",
+            args.protocol.display(),
+            p.env
+        ))
+        .into());
+    }
+    let root = args.out.join(&p.name);
+    let (pool, _) = thread_pool(args.threads)?;
+    install_interrupt();
+    if !args.analyse_only {
+        for algo in &p.algos {
+            for seed in &p.seeds {
+                let dir = root.join(algo.name()).join(format!("seed{seed}"));
+                if dir.join("metrics.json").exists() {
+                    eprintln!("{} seed {seed}: done already ({})", algo.name(), dir.display());
+                    continue;
+                }
+                let resume = if dir.join(hgym::train::checkpoint::FILE).exists() {
+                    Some(hgym::train::checkpoint::load(&dir).map_err(UsageError)?)
+                } else {
+                    None
+                };
+                let opts = TrainOptions {
+                    env_id: p.env.clone(),
+                    algo: *algo,
+                    seed: *seed,
+                    level: p.level,
+                    config: p.config.clone(),
+                    out: dir.clone(),
+                    cache: hgym::env::default_cache_dir(),
+                };
+                let label = format!("{} s{seed}", algo.name());
+                let pb = progress_bar(p.config.train.steps, &label);
+                let ending = pool
+                    .install(|| {
+                        hgym::train::train(
+                            &opts,
+                            resume,
+                            &mut |pr| {
+                                pb.set_position(pr.samples.min(pr.total));
+                                if pb.is_hidden() && pr.round % 20 == 0 {
+                                    eprintln!("{label}: {} / {} samples, return {:.2}", pr.samples, pr.total, pr.train_return);
+                                }
+                            },
+                            &|| INTERRUPTED.load(Ordering::SeqCst),
+                        )
+                    })
+                    .map_err(train_error)?;
+                pb.finish_and_clear();
+                if let Ending::Interrupted { .. } = ending {
+                    eprintln!("stopped; run the same command again to continue where it stopped");
+                    std::process::exit(130);
+                }
+                eprintln!("{} seed {seed}: finished ({})", algo.name(), dir.display());
+            }
+        }
+    }
+    let r0 = pool.install(|| uncontrolled_return(&p)).map_err(anyhow::Error::msg)?;
+    let cmp = analyse(&p, &root, r0).map_err(anyhow::Error::msg)?;
+    std::fs::create_dir_all(&root)?;
+    std::fs::write(root.join("comparison.json"), serde_json::to_string_pretty(&cmp)? + "\n")?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&cmp)?);
+    } else {
+        println!(
+            "{} on {} ({}), seeds {:?}: uncontrolled return {:.3}, {} final {:.3}, threshold {:.3}",
+            p.name,
+            p.env,
+            p.level.name(),
+            p.seeds,
+            cmp.uncontrolled_return,
+            p.reference.name(),
+            cmp.reference_final_return,
+            cmp.threshold
+        );
+        for s in &cmp.summary {
+            println!(
+                "  {:<5} final return {:8.3} +- {:.3}   samples to threshold {:8.0} +- {:.0} ({} of {} seeds reach it)   wall {:.0} s",
+                s.algo,
+                s.final_return.mean,
+                s.final_return.std,
+                s.samples_to_threshold.mean,
+                s.samples_to_threshold.std,
+                s.seeds_reaching,
+                p.seeds.len(),
+                s.wall_s.mean
+            );
+        }
+        for (a, r) in &cmp.sample_reduction_vs_reference {
+            println!("  {a} needs {:+.1} % samples vs {}", -100.0 * r, p.reference.name());
+        }
+        println!("  results: {}", root.display());
+    }
+    Ok(Outcome::Ok)
 }

@@ -6,8 +6,10 @@
 //! - [`actuation`]: jets, rotation, and the temporal smoothing of actions.
 
 pub mod actuation;
+pub mod any;
 pub mod calibrate;
 pub mod cylinder;
+pub mod kolmogorov;
 pub mod lbm_env;
 pub mod pinball;
 pub mod registry;

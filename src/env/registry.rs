@@ -40,7 +40,7 @@ pub fn get(id: &str) -> Result<EnvSpec, Vec<String>> {
 }
 
 /// Levenshtein distance (for "did you mean").
-fn edit_distance(a: &str, b: &str) -> usize {
+pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
     let b: Vec<char> = b.chars().collect();
     let mut prev: Vec<usize> = (0..=b.len()).collect();
     for (i, ca) in a.chars().enumerate() {

@@ -1,15 +1,14 @@
 //! The training configuration: one TOML file with a `[train]` table (budget, evaluation,
-//! checkpoints), one table per algorithm (`[ppo]`, `[ddpg]`, `[td3]`) and an optional `[env]`
+//! checkpoints), one table per algorithm (`[ppo]`, `[ddpg]`, `[td3]`, `[gppo]`) and an optional `[env]`
 //! table that overrides any field of the environment spec. Every field has a default;
 //! `hgym train --print-config` prints the effective file.
 
 use hgym_agents::ddpg::DdpgConfig;
+use hgym_agents::gppo::GppoConfig;
 use hgym_agents::learn::AlgoConfigs;
 use hgym_agents::ppo::PpoConfig;
 use hgym_agents::td3::Td3Config;
 use serde::{Deserialize, Serialize};
-
-use crate::env::EnvSpec;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -49,6 +48,8 @@ pub struct TrainConfig {
     pub ppo: PpoConfig,
     pub ddpg: DdpgConfig,
     pub td3: Td3Config,
+    /// GPPO's own settings; its PPO hyperparameters are those of `[ppo]`.
+    pub gppo: GppoConfig,
     /// Overrides of the environment spec (any field of `hgym envs show ID`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub env: Option<toml::Table>,
@@ -64,33 +65,12 @@ impl TrainConfig {
             ppo: self.ppo.clone(),
             ddpg: self.ddpg.clone(),
             td3: self.td3.clone(),
+            gppo: self.gppo.clone(),
         }
     }
 
     pub fn to_toml(&self) -> String {
         toml::to_string_pretty(self).unwrap_or_else(|e| format!("# cannot print the configuration: {e}\n"))
-    }
-}
-
-/// Deep-merges `overrides` into the spec's TOML form and reads it back (unknown fields and wrong
-/// types are errors that name the field).
-pub fn override_spec(spec: &EnvSpec, overrides: &toml::Table) -> Result<EnvSpec, String> {
-    let mut base = toml::Table::try_from(spec).map_err(|e| format!("cannot represent the spec as TOML: {e}"))?;
-    merge(&mut base, overrides);
-    let merged: EnvSpec = toml::Value::Table(base)
-        .try_into()
-        .map_err(|e| format!("[env] overrides of {}: {e}", spec.id))?;
-    Ok(merged)
-}
-
-fn merge(base: &mut toml::Table, over: &toml::Table) {
-    for (k, v) in over {
-        match (base.get_mut(k), v) {
-            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),
-            _ => {
-                base.insert(k.clone(), v.clone());
-            }
-        }
     }
 }
 
@@ -110,9 +90,11 @@ mod tests {
 
     #[test]
     fn env_overrides_merge_deeply() {
-        let spec = crate::env::spec("Cylinder_2D_Re100").unwrap();
+        let spec = crate::env::any::lookup("Cylinder_2D_Re100").unwrap();
         let over: toml::Table = toml::from_str("control_interval = 0.5\n[actuation]\nmax_velocity = 0.5\n").unwrap();
-        let s = override_spec(&spec, &over).unwrap();
+        let crate::env::any::AnySpec::Lbm(s) = spec.with_overrides(&over).unwrap() else {
+            panic!("family changed")
+        };
         assert_eq!(s.control_interval, 0.5);
         match s.actuation {
             crate::env::spec::ActuationSpec::ZnmfJets {
@@ -123,6 +105,12 @@ mod tests {
             _ => panic!("actuation kind changed"),
         }
         let bad: toml::Table = toml::from_str("control_intervall = 0.5\n").unwrap();
-        assert!(override_spec(&spec, &bad).unwrap_err().contains("control_intervall"));
+        assert!(spec.with_overrides(&bad).unwrap_err().contains("control_intervall"));
+        let k = crate::env::any::lookup("Kolmogorov_2D_Re40").unwrap();
+        let over: toml::Table = toml::from_str("[objective]\nkind = \"mixing\"\n").unwrap();
+        let crate::env::any::AnySpec::Kolmogorov(k) = k.with_overrides(&over).unwrap() else {
+            panic!("family changed")
+        };
+        assert_eq!(k.objective, crate::env::kolmogorov::Objective::Mixing);
     }
 }

@@ -12,6 +12,7 @@
 //!   environments from seeds derived from (seed, round) and the learner's state is complete.
 
 pub mod checkpoint;
+pub mod compare;
 pub mod config;
 pub mod curve;
 pub mod eval;
@@ -24,10 +25,10 @@ use hgym_agents::EnvError;
 use serde::{Deserialize, Serialize};
 
 use self::checkpoint::Checkpoint;
-use self::config::{override_spec, TrainConfig};
+use self::config::TrainConfig;
 use self::curve::CurveRow;
 use self::eval::{evaluate, uncontrolled_c_d, EvalReport, Stat};
-use crate::env::{EnvSpec, LbmEnv};
+use crate::env::any::{AnyEnv, AnySpec};
 use crate::report::manifest::{manifest, Manifest};
 use crate::validate::case::Level;
 
@@ -80,7 +81,7 @@ pub struct TrainManifest {
     pub schema: String,
     pub env_id: String,
     pub spec_hash: String,
-    pub spec: EnvSpec,
+    pub spec: AnySpec,
     pub level: String,
     pub algo: String,
     pub seed: u64,
@@ -94,10 +95,10 @@ pub struct TrainManifest {
 }
 
 /// The environment spec with the configuration's `[env]` overrides applied.
-pub fn resolve_spec(env_id: &str, config: &TrainConfig) -> Result<EnvSpec, TrainError> {
-    let spec = crate::env::spec(env_id).map_err(|e| TrainError::Input(e.to_string()))?;
+pub fn resolve_spec(env_id: &str, config: &TrainConfig) -> Result<AnySpec, TrainError> {
+    let spec = crate::env::any::lookup(env_id).map_err(|e| TrainError::Input(e.to_string()))?;
     match &config.env {
-        Some(over) => override_spec(&spec, over).map_err(TrainError::Input),
+        Some(over) => spec.with_overrides(over).map_err(TrainError::Input),
         None => Ok(spec),
     }
 }
@@ -121,8 +122,8 @@ pub fn train(
     let algos = config.algos();
     let n_envs = algos.n_envs(opts.algo);
     std::fs::create_dir_all(&opts.out).map_err(|e| TrainError::Io(format!("cannot create {}: {e}", opts.out.display())))?;
-    let make = || LbmEnv::new(spec.clone(), opts.level, opts.cache.clone());
-    let mut envs: Vec<LbmEnv> = (0..n_envs).map(|_| make()).collect::<Result<_, _>>()?;
+    let make = || spec.make(opts.level, opts.cache.clone());
+    let mut envs: Vec<AnyEnv> = (0..n_envs).map(|_| make()).collect::<Result<_, _>>()?;
     let mut eval_env = make()?;
     let periodic_seeds = eval_seeds(config, config.train.eval_episodes.max(1));
 
@@ -195,7 +196,7 @@ pub fn train(
                 &mut eval_env,
                 &mut policy,
                 opts.algo.name(),
-                &spec.id,
+                spec.id(),
                 &hash,
                 opts.level.name(),
                 &periodic_seeds,
@@ -233,7 +234,7 @@ pub fn train(
         &mut eval_env,
         &mut policy,
         opts.algo.name(),
-        &spec.id,
+        spec.id(),
         &hash,
         opts.level.name(),
         &final_seeds,
@@ -245,11 +246,11 @@ pub fn train(
     std::fs::write(opts.out.join("policy.json"), json(&policy) + "\n").map_err(io)?;
     std::fs::write(opts.out.join("metrics.json"), json(&report) + "\n").map_err(io)?;
     std::fs::write(opts.out.join("curve.csv"), curve::to_csv(&curve)).map_err(io)?;
-    let title = format!("{} {} seed {} ({})", spec.id, opts.algo.name(), opts.seed, opts.level.name());
+    let title = format!("{} {} seed {} ({})", spec.id(), opts.algo.name(), opts.seed, opts.level.name());
     curve::plot(&opts.out, &title, &curve).map_err(TrainError::Io)?;
     let m = TrainManifest {
         schema: "hgym/train/v1".into(),
-        env_id: spec.id.clone(),
+        env_id: spec.id().to_string(),
         spec_hash: hash,
         spec: spec.clone(),
         level: opts.level.name().into(),

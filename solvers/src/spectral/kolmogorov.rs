@@ -108,7 +108,7 @@ pub struct Kolmogorov {
 impl Kolmogorov {
     pub fn new(cfg: KolmogorovConfig) -> Result<Self, SpectralError> {
         let n = cfg.n;
-        if n < 8 || n % 2 != 0 {
+        if n < 8 || !n.is_multiple_of(2) {
             return Err(SpectralError::Grid(n));
         }
         if !(cfg.reynolds > 0.0 && cfg.reynolds.is_finite()) {

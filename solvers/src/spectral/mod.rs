@@ -4,6 +4,9 @@
 //! - [`kolmogorov`]: 2D Navier-Stokes in vorticity form with Kolmogorov forcing, Lawson RK4,
 //!   and the vector-Jacobian product of a step.
 
+// Index loops over spectral coefficients read like the formulas they implement.
+#![allow(clippy::needless_range_loop)]
+
 pub mod fft2;
 pub mod kolmogorov;
 

@@ -1,0 +1,525 @@
+//! Kolmogorov flow (`Kolmogorov_2D_Re{40,100,200}`): 2D turbulence on `(0, 2 pi)^2` driven by
+//! `sin(k_f y) e_x` with `k_f = 4` (the paper's differentiable environment; Farazmand & Sapsis
+//! 2017 for the bursting regime at Re 40), on the pseudo-spectral solver of
+//! `hgym_solvers::spectral` and its discrete adjoint.
+//!
+//! - Actions: four amplitudes `a_i` of extra forcing `a_i sin(k_i y) e_x`, `k_i = 4, 5, 6, 7`;
+//!   normalised actions in [-1, 1] map to `a_i = action * max_amplitude` (bound in units of the
+//!   base forcing amplitude). Constant over a control interval (no ramp: the forcing enters the
+//!   vorticity equation directly, there is no actuator to accelerate).
+//! - Observations: `(u, v)` at an 8 x 8 grid of points `(2 pi i / 8, 2 pi j / 8)` (grid nodes at
+//!   every level), divided by `3 u_rms` of the uncontrolled flow.
+//! - Rewards, averaged over the solver steps of the interval (`eps` the dissipation rate
+//!   `nu <omega^2>`, `eps_lam = Re / (2 k_f^2)` the laminar one):
+//!   `dissipation`: `r = -mean(eps + w max(0, eps - theta)) / eps_lam - c |a|^2` with
+//!   `theta = mean + 3 std` of the uncontrolled dissipation (the paper's extreme events);
+//!   `mixing`: `r = mean(TKE) / TKE_ref - c |a|^2` with TKE the kinetic energy of the fluctuation
+//!   about the x-averaged profile and `TKE_ref` its uncontrolled mean. HydroGym's JAX env ships
+//!   with a zero TKE weight, so its default reward ignores the flow; here the flow term always
+//!   counts. `|a|^2` is the sum of squared normalised actions.
+//! - Differentiable: [`DifferentiableEnv::reward_action_gradients`] sweeps back over the stored
+//!   states with the solver's step VJP.
+
+use std::collections::HashMap;
+use std::sync::{Mutex, OnceLock};
+
+use hgym_agents::{BoxSpace, DifferentiableEnv, Env, EnvError, Info, StepResult};
+use hgym_solvers::spectral::{Complex64 as C, Kolmogorov, KolmogorovConfig};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+
+use crate::validate::case::{Level, ResolutionSpec};
+
+pub const REYNOLDS: [u32; 3] = [40, 100, 200];
+
+/// What the reward asks for.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Objective {
+    /// Penalise the dissipation rate, and by `extreme_weight` its excess over mean + 3 std.
+    Dissipation { extreme_weight: f64 },
+    /// Reward turbulent kinetic energy (mixing).
+    Mixing,
+}
+
+/// Statistics of the uncontrolled flow (`hgym envs calibrate ID`), at the default level.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, Default)]
+#[serde(deny_unknown_fields)]
+pub struct FlowStatistics {
+    pub spec_hash: String,
+    pub level: String,
+    pub time: f64,
+    pub u_rms: f64,
+    pub dissipation_mean: f64,
+    pub dissipation_std: f64,
+    pub tke_mean: f64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct KolmogorovSpec {
+    pub id: String,
+    pub family: String,
+    pub description: String,
+    pub reynolds: f64,
+    pub kf: u32,
+    /// Grid points per side at each level.
+    pub resolution: ResolutionSpec,
+    /// Solver time step on the 64-point grid; other grids scale it by 64 / n (same CFL).
+    pub dt_at_64: f64,
+    pub control_wavenumbers: Vec<u32>,
+    /// Bound of each control amplitude, in units of the base forcing amplitude.
+    pub max_amplitude: f64,
+    /// Time between actions (units of 1 / (k_1 U) with the forcing's natural scales: L = 1, A = 1).
+    pub control_interval: f64,
+    pub episode_actions: usize,
+    /// Uncontrolled time from the perturbed laminar state to the attractor.
+    pub spin_up: f64,
+    /// Probes per side (the observation grid).
+    pub probes_per_side: usize,
+    pub objective: Objective,
+    /// Weight `c` of the action penalty `c |a|^2`.
+    pub action_penalty: f64,
+    #[serde(default)]
+    pub statistics: FlowStatistics,
+}
+
+impl KolmogorovSpec {
+    pub fn hash(&self) -> String {
+        let json = serde_json::to_string(self).unwrap_or_default();
+        format!("{:x}", Sha256::digest(json.as_bytes()))
+    }
+
+    /// Hash of what shapes the uncontrolled flow (for the statistics and the attractor cache).
+    pub fn physics_hash(&self) -> String {
+        let physics = (self.reynolds, self.kf, &self.resolution, self.dt_at_64, self.spin_up);
+        format!(
+            "{:x}",
+            Sha256::digest(serde_json::to_string(&physics).unwrap_or_default().as_bytes())
+        )
+    }
+
+    pub fn obs_dim(&self) -> usize {
+        2 * self.probes_per_side * self.probes_per_side
+    }
+
+    pub fn act_dim(&self) -> usize {
+        self.control_wavenumbers.len()
+    }
+
+    pub fn n(&self, level: Level) -> usize {
+        (match level {
+            Level::Coarse => self.resolution.coarse,
+            Level::Default => self.resolution.default,
+            Level::Fine => self.resolution.fine,
+        }) as usize
+    }
+
+    pub fn dt(&self, level: Level) -> f64 {
+        self.dt_at_64 * 64.0 / self.n(level) as f64
+    }
+
+    /// Laminar dissipation rate `Re / (2 k_f^2)`.
+    pub fn dissipation_laminar(&self) -> f64 {
+        self.reynolds / (2.0 * (self.kf as f64).powi(2))
+    }
+
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).unwrap_or_else(|e| format!("# cannot print the spec as TOML: {e}\n"))
+    }
+}
+
+/// The committed statistics table.
+pub const TABLE: &str = include_str!("../../benchmarks/envs/kolmogorov.toml");
+
+pub fn spec(re: u32) -> KolmogorovSpec {
+    let mut s = KolmogorovSpec {
+        id: format!("Kolmogorov_2D_Re{re}"),
+        family: "kolmogorov".into(),
+        description: format!("2D Kolmogorov flow at Re {re}, k_f = 4, forcing amplitudes at k = 4..7"),
+        reynolds: re as f64,
+        kf: 4,
+        resolution: ResolutionSpec {
+            coarse: 32,
+            default: 64,
+            fine: 128,
+        },
+        // Advective CFL (|u| + |v|) k_max dt stays below ~1 on the attractor.
+        dt_at_64: match re {
+            40 => 0.02,
+            100 => 0.01,
+            _ => 0.005,
+        },
+        control_wavenumbers: vec![4, 5, 6, 7],
+        max_amplitude: 0.5,
+        control_interval: 1.0,
+        episode_actions: 100,
+        spin_up: 300.0,
+        probes_per_side: 8,
+        objective: Objective::Dissipation { extreme_weight: 10.0 },
+        action_penalty: 0.1,
+        statistics: FlowStatistics::default(),
+    };
+    if let Ok(table) = toml::from_str::<HashMap<String, FlowStatistics>>(TABLE) {
+        if let Some(st) = table.get(&s.id) {
+            if st.spec_hash == s.physics_hash() {
+                s.statistics = st.clone();
+            }
+        }
+    }
+    s
+}
+
+pub fn all() -> Vec<KolmogorovSpec> {
+    REYNOLDS.iter().map(|re| spec(*re)).collect()
+}
+
+/// Attractor states shared by every env of the process, keyed by physics hash and level.
+fn attractors() -> &'static Mutex<HashMap<String, Vec<C>>> {
+    static CACHE: OnceLock<Mutex<HashMap<String, Vec<C>>>> = OnceLock::new();
+    CACHE.get_or_init(|| Mutex::new(HashMap::new()))
+}
+
+fn splitmix64(seed: u64) -> u64 {
+    let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+fn backend(e: impl std::fmt::Display) -> EnvError {
+    EnvError::Backend(e.to_string())
+}
+
+/// One control interval of the stored trajectory.
+struct Record {
+    start: Vec<C>,
+    physical: Vec<f64>,
+    normalised: Vec<f64>,
+}
+
+pub struct KolmogorovEnv {
+    spec: KolmogorovSpec,
+    level: Level,
+    solver: Kolmogorov,
+    substeps: usize,
+    history: Vec<Record>,
+    live: bool,
+    theta: f64,
+    tke_ref: f64,
+    obs_scale: f64,
+}
+
+impl KolmogorovEnv {
+    pub fn new(spec: KolmogorovSpec, level: Level) -> Result<Self, EnvError> {
+        let n = spec.n(level);
+        let cfg = KolmogorovConfig {
+            n,
+            reynolds: spec.reynolds,
+            kf: spec.kf,
+            forcing: 1.0,
+            dt: spec.dt(level),
+            control_wavenumbers: spec.control_wavenumbers.clone(),
+        };
+        if spec.probes_per_side == 0 || !n.is_multiple_of(spec.probes_per_side) {
+            return Err(EnvError::Backend(format!(
+                "{}: {} probes per side do not sit on the {n}-point grid",
+                spec.id, spec.probes_per_side
+            )));
+        }
+        let solver = Kolmogorov::new(cfg).map_err(backend)?;
+        let substeps = (spec.control_interval / spec.dt(level)).round().max(1.0) as usize;
+        let st = &spec.statistics;
+        let calibrated = st.u_rms > 0.0;
+        Ok(KolmogorovEnv {
+            theta: if calibrated {
+                st.dissipation_mean + 3.0 * st.dissipation_std
+            } else {
+                f64::INFINITY
+            },
+            tke_ref: if calibrated { st.tke_mean } else { 1.0 },
+            obs_scale: if calibrated { 3.0 * st.u_rms } else { 1.0 },
+            spec,
+            level,
+            solver,
+            substeps,
+            history: vec![],
+            live: false,
+        })
+    }
+
+    pub fn spec(&self) -> &KolmogorovSpec {
+        &self.spec
+    }
+
+    pub fn solver(&mut self) -> &mut Kolmogorov {
+        &mut self.solver
+    }
+
+    pub fn substeps(&self) -> usize {
+        self.substeps
+    }
+
+    /// The developed flow: from the process cache, or spun up from the laminar state with a
+    /// fixed large-scale perturbation.
+    fn attractor(&mut self) -> Result<Vec<C>, EnvError> {
+        let key = format!("{}-{}", self.spec.physics_hash(), self.level.name());
+        if let Some(w) = attractors().lock().ok().and_then(|m| m.get(&key).cloned()) {
+            return Ok(w);
+        }
+        let n = self.solver.n();
+        let h = 2.0 * std::f64::consts::PI / n as f64;
+        let lam = self.solver.laminar();
+        let kick: Vec<f64> = (0..n * n)
+            .map(|i| {
+                let (x, y) = ((i % n) as f64 * h, (i / n) as f64 * h);
+                0.5 * (x.cos() + (x + 2.0 * y).sin() + 0.5 * (3.0 * x - y).cos())
+            })
+            .collect();
+        self.solver.set_vorticity(&kick);
+        let w: Vec<C> = self.solver.omega.iter().zip(&lam).map(|(a, b)| *a + *b).collect();
+        self.solver.omega = w;
+        let steps = (self.spec.spin_up / self.spec.dt(self.level)).round() as usize;
+        let zero = vec![0.0; self.spec.act_dim()];
+        for _ in 0..steps {
+            self.solver
+                .step(&zero)
+                .map_err(|e| EnvError::Backend(format!("{}: spin-up failed: {e}", self.spec.id)))?;
+        }
+        let w = self.solver.omega.clone();
+        if let Ok(mut m) = attractors().lock() {
+            m.insert(key, w.clone());
+        }
+        Ok(w)
+    }
+
+    fn observation(&mut self) -> Vec<f64> {
+        let (u, v) = self.solver.velocity();
+        let n = self.solver.n();
+        let p = self.spec.probes_per_side;
+        let stride = n / p;
+        let mut obs = Vec::with_capacity(2 * p * p);
+        for j in 0..p {
+            for i in 0..p {
+                let k = (j * stride) * n + i * stride;
+                obs.push(u[k] / self.obs_scale);
+                obs.push(v[k] / self.obs_scale);
+            }
+        }
+        obs
+    }
+
+    /// The per-substep flow term of the reward at state `w` (before the 1/M average).
+    fn flow_term(&self, w: &[C]) -> f64 {
+        match self.spec.objective {
+            Objective::Dissipation { extreme_weight } => {
+                let e = self.solver.dissipation_of(w);
+                -(e + extreme_weight * (e - self.theta).max(0.0)) / self.spec.dissipation_laminar()
+            }
+            Objective::Mixing => self.solver.tke_of(w) / self.tke_ref,
+        }
+    }
+
+    /// Adds `scale * d(flow_term)/dw` to `out`.
+    fn add_flow_gradient(&self, w: &[C], scale: f64, out: &mut [C]) {
+        match self.spec.objective {
+            Objective::Dissipation { extreme_weight } => {
+                let e = self.solver.dissipation_of(w);
+                let slope = 1.0 + if e > self.theta { extreme_weight } else { 0.0 };
+                self.solver
+                    .add_dissipation_gradient(w, -scale * slope / self.spec.dissipation_laminar(), out);
+            }
+            Objective::Mixing => self.solver.add_tke_gradient(w, scale / self.tke_ref, out),
+        }
+    }
+
+    /// Recomputes the reward from a step's info (the contract's consistency check).
+    pub fn reward_from_info(&self, info: &Info) -> f64 {
+        let flow = match self.spec.objective {
+            Objective::Dissipation { extreme_weight } => {
+                -(info.get("dissipation").unwrap_or(f64::NAN) + extreme_weight * info.get("dissipation_excess").unwrap_or(f64::NAN))
+                    / self.spec.dissipation_laminar()
+            }
+            Objective::Mixing => info.get("tke").unwrap_or(f64::NAN) / self.tke_ref,
+        };
+        flow - self.spec.action_penalty * info.get("action_sq").unwrap_or(f64::NAN)
+    }
+}
+
+impl Env for KolmogorovEnv {
+    fn observation_space(&self) -> BoxSpace {
+        BoxSpace::uniform(self.spec.obs_dim(), -5.0, 5.0)
+    }
+
+    fn action_space(&self) -> BoxSpace {
+        BoxSpace::unit(self.spec.act_dim())
+    }
+
+    fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
+        self.solver.omega = self.attractor()?;
+        let zero = vec![0.0; self.spec.act_dim()];
+        // A seed-dependent start on the attractor: 0-63 half control intervals further on.
+        let offset = (splitmix64(seed) % 64) as usize * (self.substeps / 2).max(1);
+        for _ in 0..offset {
+            self.solver.step(&zero).map_err(backend)?;
+        }
+        self.history.clear();
+        self.live = true;
+        let mut info = Info::default();
+        info.set("t", 0.0);
+        info.set("phase_steps", offset as f64);
+        info.set("dissipation", self.solver.dissipation());
+        info.set("tke", self.solver.tke());
+        Ok((self.observation(), info))
+    }
+
+    fn step(&mut self, action: &[f64]) -> Result<StepResult, EnvError> {
+        if !self.live {
+            return Err(EnvError::NeedsReset);
+        }
+        let dim = self.spec.act_dim();
+        if action.len() != dim {
+            return Err(EnvError::ActionShape {
+                expected: dim,
+                got: action.len(),
+            });
+        }
+        if let Some((index, value)) = action.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(EnvError::NonFiniteAction { index, value: *value });
+        }
+        let mut a = action.to_vec();
+        let clipped = self.action_space().clip(&mut a);
+        let physical: Vec<f64> = a.iter().map(|v| v * self.spec.max_amplitude).collect();
+        self.history.push(Record {
+            start: self.solver.omega.clone(),
+            physical: physical.clone(),
+            normalised: a.clone(),
+        });
+        let m = self.substeps;
+        let (mut eps, mut excess, mut tke, mut flow) = (0.0, 0.0, 0.0, 0.0);
+        let mut failure = None;
+        for _ in 0..m {
+            if let Err(e) = self.solver.step(&physical) {
+                failure = Some(e.to_string());
+                break;
+            }
+            let e = self.solver.dissipation();
+            eps += e / m as f64;
+            excess += (e - self.theta).max(0.0) / m as f64;
+            tke += self.solver.tke() / m as f64;
+            flow += self.flow_term(&self.solver.omega) / m as f64;
+        }
+        let t = self.history.len() as f64 * self.spec.control_interval;
+        let mut info = Info::default();
+        info.set("t", t);
+        info.set("clipped", clipped as f64);
+        for (k, v) in physical.iter().enumerate() {
+            info.set(&format!("actuation_{k}"), *v);
+        }
+        let action_sq: f64 = a.iter().map(|v| v * v).sum();
+        info.set("action_sq", action_sq);
+        info.set("dissipation", eps);
+        info.set("dissipation_excess", excess);
+        info.set("D_over_Dlam", eps / self.spec.dissipation_laminar());
+        info.set("tke", tke);
+        if let Some(reason) = failure {
+            self.live = false;
+            info.set("diverged", 1.0);
+            info.set_text("reason", reason);
+            return Ok(StepResult {
+                obs: vec![0.0; self.spec.obs_dim()],
+                reward: 0.0,
+                terminated: true,
+                truncated: false,
+                info,
+            });
+        }
+        let reward = flow - self.spec.action_penalty * action_sq;
+        let truncated = self.history.len() >= self.spec.episode_actions;
+        if truncated {
+            self.live = false;
+        }
+        Ok(StepResult {
+            obs: self.observation(),
+            reward,
+            terminated: false,
+            truncated,
+            info,
+        })
+    }
+}
+
+impl DifferentiableEnv for KolmogorovEnv {
+    fn reward_action_gradients(&mut self, k: usize) -> Result<Vec<Vec<f64>>, EnvError> {
+        let total = self.history.len();
+        let k = k.min(total);
+        let len = self.solver.spectral_len();
+        let m = self.substeps;
+        let mut lambda = vec![C::default(); len];
+        let mut lambda_prev = vec![C::default(); len];
+        let mut out = vec![vec![0.0; self.spec.act_dim()]; k];
+        let mut states: Vec<Vec<C>> = vec![vec![C::default(); len]; m + 1];
+        for j in (total - k..total).rev() {
+            let rec = &self.history[j];
+            let (start, physical, normalised) = (rec.start.clone(), rec.physical.clone(), rec.normalised.clone());
+            // Replay the interval, keeping every substep state (checkpointing at actions).
+            states[0].copy_from_slice(&start);
+            for s in 0..m {
+                let (done, rest) = states.split_at_mut(s + 1);
+                self.solver.step_from(&done[s], &physical, &mut rest[0]).map_err(backend)?;
+            }
+            let mut bar_a = vec![0.0; self.spec.act_dim()];
+            for s in (1..=m).rev() {
+                self.add_flow_gradient(&states[s], 1.0 / m as f64, &mut lambda);
+                self.solver
+                    .step_vjp(&states[s - 1], &physical, &lambda, &mut lambda_prev, &mut bar_a)
+                    .map_err(backend)?;
+                std::mem::swap(&mut lambda, &mut lambda_prev);
+            }
+            let g = &mut out[j - (total - k)];
+            for ((g, ba), an) in g.iter_mut().zip(&bar_a).zip(&normalised) {
+                *g = ba * self.spec.max_amplitude - 2.0 * self.spec.action_penalty * an;
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// Runs `actions` uncontrolled intervals from `reset(0)` and returns the flow's statistics:
+/// RMS probe velocity, mean and standard deviation of the interval-mean dissipation, mean TKE.
+pub fn calibrate(spec: &KolmogorovSpec, level: Level, actions: usize, progress: &mut dyn FnMut(usize)) -> Result<FlowStatistics, EnvError> {
+    let mut raw = spec.clone();
+    raw.statistics = FlowStatistics::default();
+    raw.episode_actions = actions.max(1);
+    let mut env = KolmogorovEnv::new(raw, level)?;
+    env.reset(0)?;
+    let zero = vec![0.0; spec.act_dim()];
+    let (mut u2, mut count, mut eps, mut tke) = (0.0, 0usize, vec![], 0.0);
+    for k in 0..actions.max(1) {
+        let r = env.step(&zero)?;
+        if r.terminated {
+            return Err(EnvError::Backend(format!(
+                "{}: uncontrolled run diverged: {}",
+                spec.id,
+                r.info.text("reason").unwrap_or("?")
+            )));
+        }
+        u2 += r.obs.iter().map(|v| v * v).sum::<f64>();
+        count += r.obs.len();
+        eps.push(r.info.get("dissipation").unwrap_or(f64::NAN));
+        tke += r.info.get("tke").unwrap_or(f64::NAN);
+        progress(k + 1);
+    }
+    let n = eps.len() as f64;
+    let mean = eps.iter().sum::<f64>() / n;
+    let std = (eps.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt();
+    Ok(FlowStatistics {
+        spec_hash: spec.physics_hash(),
+        level: level.name().into(),
+        time: n * spec.control_interval,
+        u_rms: (u2 / count.max(1) as f64).sqrt(),
+        dissipation_mean: mean,
+        dissipation_std: std,
+        tke_mean: tke / n,
+    })
+}
