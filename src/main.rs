@@ -169,6 +169,15 @@ enum BenchCommand {
         #[arg(long)]
         threads: Option<usize>,
     },
+    /// Spectral Kolmogorov solver: steps/s at N 64-256, VJP cost, accuracy against step size,
+    /// against HydroGym's JAX env measured on this machine. Exit 1 if short of the targets.
+    Kolmogorov {
+        #[arg(long)]
+        json: bool,
+        /// Short timings and a 1-time-unit action (targets not judged).
+        #[arg(long)]
+        quick: bool,
+    },
     /// Control steps (actions) per second of each environment family at coarse and default.
     Envs {
         /// Print the rows as JSON.
@@ -214,6 +223,19 @@ fn main() -> ExitCode {
         Command::Eval(args) => cli::train::run_eval(args),
         Command::Compare(args) => cli::train::run_compare(args),
         Command::Bench(BenchCommand::Agents { json, quick, threads }) => cli::train::run_bench_agents(json, quick, threads),
+        Command::Bench(BenchCommand::Kolmogorov { json, quick }) => {
+            let b = hgym::bench::kolmogorov::bench_kolmogorov(quick);
+            if json {
+                serde_json::to_string_pretty(&b)
+                    .map(|t| println!("{t}"))
+                    .map_err(anyhow::Error::from)
+                    .map(|_| ())
+            } else {
+                print!("{}", hgym::bench::kolmogorov::table(&b));
+                Ok(())
+            }
+            .map(|_| if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
+        }
     };
     match result {
         Ok(Outcome::Ok) => ExitCode::SUCCESS,
@@ -260,6 +282,29 @@ fn progress_bar(total: u64, label: &str) -> ProgressBar {
 }
 
 fn run_validate(args: ValidateArgs) -> Result<Outcome> {
+    if args.family.as_deref() == Some("kolmogorov") {
+        let (pool, _) = thread_pool(args.threads)?;
+        let time = 2000.0;
+        let pb = progress_bar((time / 0.5) as u64, "kolmogorov Re 40");
+        let r = pool
+            .install(|| hgym::validate::kolmogorov::validate(args.level, time, &args.out, &mut |k, _| pb.set_position(k as u64)))
+            .context("Kolmogorov validation")?;
+        pb.finish_and_clear();
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&r)?);
+        } else {
+            println!(
+                "kolmogorov_re40 ({}, {}^2, dt {}, {} time units): D/D_lam mean {:.4} std {:.4} max {:.3}; {} bursts above {:.3} ({:.2} % of the time, {:.1} time units each)",
+                r.level, r.n, r.dt, r.time, r.mean_d_over_dlam, r.std_d_over_dlam, r.max_d_over_dlam, r.bursts,
+                r.threshold_d_over_dlam, 100.0 * r.burst_time_fraction, r.mean_burst_duration
+            );
+            for (c, ok) in &r.checks {
+                println!("  {} {c}", if *ok { "pass" } else { "FAIL" });
+            }
+            println!("  results: {}", args.out.join("kolmogorov_re40.json").display());
+        }
+        return Ok(if r.pass { Outcome::Ok } else { Outcome::CheckFailed });
+    }
     if args.list {
         for c in validate::bundled()? {
             println!("{:<10} {:<18} {}", c.case.case.family, c.case.case.name, c.case.case.description);

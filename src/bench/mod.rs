@@ -12,6 +12,7 @@
 
 pub mod agents;
 pub mod envs;
+pub mod kolmogorov;
 mod lbm;
 mod stream;
 

@@ -312,7 +312,10 @@ pub fn lines(path: &Path, title: &str, x_label: &str, y_label: &str, lines: &[Li
                 .map_err(err(path))?;
         }
         chart
-            .draw_series(LineSeries::new(pts.iter().map(|(x, y, _)| (*x, *y)), c.stroke_width(2)))
+            .draw_series(LineSeries::new(
+                pts.iter().map(|(x, y, _)| (*x, y.clamp(y_lo(&chart), y_hi(&chart)))),
+                c.stroke_width(2),
+            ))
             .map_err(err(path))?
             .label(l.label)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));

@@ -9,6 +9,7 @@
 
 pub mod analysis;
 pub mod case;
+pub mod kolmogorov;
 pub mod report;
 pub mod run;
 

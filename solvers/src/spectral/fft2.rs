@@ -87,19 +87,46 @@ impl Fft2 {
         self.fwd.process_with_scratch(&mut out[..self.active * n], &mut self.scratch_c);
     }
 
+    /// [`Fft2::forward`] that uses `phys` as its work array (its content is destroyed).
+    pub fn forward_destroying(&mut self, phys: &mut [f64], out: &mut [Complex64]) {
+        let (n, nh) = (self.n, self.nh);
+        assert_eq!(phys.len(), n * n);
+        assert_eq!(out.len(), n * nh);
+        for y in 0..n {
+            // Lengths match the plan, so the transform cannot fail.
+            let _ = self
+                .r2c
+                .process_with_scratch(&mut phys[y * n..(y + 1) * n], &mut self.row_spec, &mut self.scratch_r);
+            for kx in 0..self.active {
+                out[kx * n + y] = self.row_spec[kx];
+            }
+        }
+        out[self.active * n..].iter_mut().for_each(|c| *c = Complex64::default());
+        self.fwd.process_with_scratch(&mut out[..self.active * n], &mut self.scratch_c);
+    }
+
     /// `phys = IFFT2(spec) / n^2` (only the `active` columns of `spec` are read).
     pub fn inverse(&mut self, spec: &[Complex64], phys: &mut [f64]) {
+        let m = self.active * self.n;
+        let mut cols = std::mem::take(&mut self.cols);
+        cols[..m].copy_from_slice(&spec[..m]);
+        self.inverse_destroying(&mut cols, phys);
+        self.cols = cols;
+    }
+
+    /// [`Fft2::inverse`] that uses `spec` as its work array (its content is destroyed): one copy
+    /// less for spectra that are scratch anyway.
+    pub fn inverse_destroying(&mut self, spec: &mut [Complex64], phys: &mut [f64]) {
         let (n, nh) = (self.n, self.nh);
         assert_eq!(spec.len(), n * nh);
         assert_eq!(phys.len(), n * n);
         let m = self.active * n;
-        self.cols[..m].copy_from_slice(&spec[..m]);
-        self.inv.process_with_scratch(&mut self.cols[..m], &mut self.scratch_c);
+        self.inv.process_with_scratch(&mut spec[..m], &mut self.scratch_c);
         let scale = 1.0 / (n * n) as f64;
         for y in 0..n {
             let r = &mut self.rows[y * nh..(y + 1) * nh];
             for kx in 0..self.active {
-                r[kx] = self.cols[kx * n + y] * scale;
+                r[kx] = spec[kx * n + y] * scale;
             }
             r[self.active..].iter_mut().for_each(|c| *c = Complex64::default());
             // A real field has real x-mean and x-Nyquist coefficients; drop round-off there.

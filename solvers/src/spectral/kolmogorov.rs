@@ -75,6 +75,7 @@ impl Fields {
 struct Work {
     spec: [Vec<C>; 4],
     prod: Vec<f64>,
+    prod_b: Vec<f64>,
     k: [Vec<C>; 4],
     s: Vec<C>,
     forcing: Vec<C>,
@@ -89,7 +90,11 @@ pub struct Kolmogorov {
     nu: f64,
     n: usize,
     len: usize,
+    /// Coefficients of the dealiased columns `k_x <= k_max` (the rest are zero throughout).
+    act: usize,
     fft: Fft2,
+    /// A second transform with its own scratch, so independent transforms run on two threads.
+    fft_b: Fft2,
     kx: Vec<f64>,
     ky: Vec<f64>,
     inv_k2: Vec<f64>,
@@ -160,9 +165,11 @@ impl Kolmogorov {
         let z = || vec![C::default(); len];
         Ok(Kolmogorov {
             fft: Fft2::new(n, kmax + 1),
+            fft_b: Fft2::new(n, kmax + 1),
             nu,
             n,
             len,
+            act: (kmax + 1) * n,
             kx,
             ky,
             inv_k2,
@@ -176,6 +183,7 @@ impl Kolmogorov {
             w: Work {
                 spec: [z(), z(), z(), z()],
                 prod: vec![0.0; m],
+                prod_b: vec![0.0; m],
                 k: [z(), z(), z(), z()],
                 s: z(),
                 forcing: z(),
@@ -312,18 +320,29 @@ impl Kolmogorov {
     /// `u, v, omega_x, omega_y` of `w` into stage slot `slot`.
     fn fields(&mut self, w: &[C], slot: usize) {
         let [s0, s1, s2, s3] = &mut self.w.spec;
-        for i in 0..self.len {
+        for i in 0..self.act {
             let (kx, ky, ik2) = (self.kx[i], self.ky[i], self.inv_k2[i]);
-            s0[i] = w[i] * C::new(0.0, ky * ik2);
-            s1[i] = w[i] * C::new(0.0, -kx * ik2);
-            s2[i] = w[i] * C::new(0.0, kx);
-            s3[i] = w[i] * C::new(0.0, ky);
+            // i a w for real a, written out (multiplying by C::new(0, a) wastes two products).
+            let iw = C::new(-w[i].im, w[i].re);
+            s0[i] = iw * (ky * ik2);
+            s1[i] = iw * (-kx * ik2);
+            s2[i] = iw * kx;
+            s3[i] = iw * ky;
         }
-        let f = &mut self.w.stage[slot];
-        self.fft.inverse(s0, &mut f.u);
-        self.fft.inverse(s1, &mut f.v);
-        self.fft.inverse(s2, &mut f.wx);
-        self.fft.inverse(s3, &mut f.wy);
+        let Fields { u, v, wx, wy } = &mut self.w.stage[slot];
+        let (fa, fb) = (&mut self.fft, &mut self.fft_b);
+        // Two independent pairs of transforms, one per thread (each transform is computed the
+        // same way on either, so results do not depend on the thread count).
+        rayon::join(
+            || {
+                fa.inverse_destroying(s0, u);
+                fa.inverse_destroying(s1, v);
+            },
+            || {
+                fb.inverse_destroying(s2, wx);
+                fb.inverse_destroying(s3, wy);
+            },
+        );
     }
 
     /// `out = -P FFT(u omega_x + v omega_y) + forcing` at `w`, keeping the fields in `slot`.
@@ -334,8 +353,8 @@ impl Kolmogorov {
             *p = u * wx + v * wy;
         }
         let out = &mut self.w.k[out_slot];
-        self.fft.forward(&self.w.prod, out);
-        for ((o, m), fc) in out.iter_mut().zip(&self.mask).zip(&self.w.forcing) {
+        self.fft.forward_destroying(&mut self.w.prod, out);
+        for ((o, m), fc) in out[..self.act].iter_mut().zip(&self.mask).zip(&self.w.forcing) {
             *o = -*o * *m + *fc;
         }
     }
@@ -361,21 +380,23 @@ impl Kolmogorov {
         let h = self.cfg.dt;
         self.rhs(w0, 0, 0);
         let mut s = std::mem::take(&mut self.w.s);
-        for i in 0..self.len {
+        let a = self.act;
+        for i in 0..a {
             s[i] = self.e_half[i] * (w0[i] + self.w.k[0][i] * (h / 2.0));
         }
         self.rhs(&s, 1, 1);
-        for i in 0..self.len {
+        for i in 0..a {
             s[i] = self.e_half[i] * w0[i] + self.w.k[1][i] * (h / 2.0);
         }
         self.rhs(&s, 2, 2);
-        for i in 0..self.len {
+        for i in 0..a {
             s[i] = self.e_full[i] * w0[i] + self.e_half[i] * self.w.k[2][i] * h;
         }
         self.rhs(&s, 3, 3);
         self.w.s = s;
         let k = &self.w.k;
-        for i in 0..self.len {
+        w1[a..].iter_mut().for_each(|c| *c = C::default());
+        for i in 0..a {
             let (e, e2) = (self.e_full[i], self.e_half[i]);
             w1[i] = e * w0[i] + (e * k[0][i] + (k[1][i] + k[2][i]) * (2.0 * e2) + k[3][i]) * (h / 6.0);
         }
@@ -407,31 +428,36 @@ impl Kolmogorov {
     /// + k_y F(v mu)]` (the conjugate symbols of `-P (u omega_x + v omega_y)`'s linearisation).
     fn nonlinear_vjp(&mut self, slot: usize, lambda: &[C], out: &mut [C]) {
         let s = &mut self.w.spec[0];
-        for i in 0..self.len {
+        for i in 0..self.act {
             s[i] = lambda[i] * self.mask[i];
         }
-        self.fft.inverse(s, &mut self.w.mu);
+        self.fft.inverse_destroying(s, &mut self.w.mu);
         let f = &self.w.stage[slot];
-        let [_, s1, s2, s3] = &mut self.w.spec;
-        let mut products = [(&f.wx, &mut *s1), (&f.u, &mut *s2), (&f.wy, &mut *s3)];
-        for (field, spec) in products.iter_mut() {
-            for ((p, a), b) in self.w.prod.iter_mut().zip(field.iter()).zip(&self.w.mu) {
-                *p = a * b;
-            }
-            self.fft.forward(&self.w.prod, spec);
-        }
-        for i in 0..self.len {
+        let [s0, s1, s2, s3] = &mut self.w.spec;
+        let (fa, fb) = (&mut self.fft, &mut self.fft_b);
+        let (pa, pb) = (&mut self.w.prod, &mut self.w.prod_b);
+        let mu = &self.w.mu;
+        let product = |p: &mut Vec<f64>, a: &[f64]| p.iter_mut().zip(a).zip(mu).for_each(|((p, a), b)| *p = a * b);
+        rayon::join(
+            || {
+                product(pa, &f.wx);
+                fa.forward_destroying(pa, s1);
+                product(pa, &f.u);
+                fa.forward_destroying(pa, s2);
+            },
+            || {
+                product(pb, &f.wy);
+                fb.forward_destroying(pb, s3);
+                product(pb, &f.v);
+                fb.forward_destroying(pb, s0);
+            },
+        );
+        for i in 0..self.act {
             let (kx, ky, ik2) = (self.kx[i], self.ky[i], self.inv_k2[i]);
-            out[i] = (s1[i] * (ky * ik2) + s2[i] * kx - s3[i] * (kx * ik2)) * C::new(0.0, 1.0);
+            let z = s1[i] * (ky * ik2) + s2[i] * kx - s3[i] * (kx * ik2) + s0[i] * ky;
+            out[i] = C::new(-z.im, z.re);
         }
-        for ((p, a), b) in self.w.prod.iter_mut().zip(&f.v).zip(&self.w.mu) {
-            *p = a * b;
-        }
-        let s0 = &mut self.w.spec[0];
-        self.fft.forward(&self.w.prod, s0);
-        for i in 0..self.len {
-            out[i] += s0[i] * C::new(0.0, self.ky[i]);
-        }
+        out[self.act..].iter_mut().for_each(|c| *c = C::default());
     }
 
     /// Vector-Jacobian product of one step from `w0` with controls `a`: given the cotangent
