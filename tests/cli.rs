@@ -233,8 +233,10 @@ fn committed_validation_reports_match_the_schema() {
         let p = entry.unwrap().path();
         if p.extension().is_some_and(|e| e == "json") {
             let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&p).unwrap()).unwrap();
-            schema_check(&v);
-            n += 1;
+            if v["schema"] == "hgym/validation/v1" {
+                schema_check(&v);
+                n += 1;
+            }
         }
     }
     assert!(n >= 2, "expected the committed cylinder reports in {}", dir.display());

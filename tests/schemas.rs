@@ -1,0 +1,76 @@
+//! Every JSON file under `results/` validates against its schema in `schemas/` (chosen by the
+//! file's `schema` field, or by its name for the files that have none: `policy.json`, rollout
+//! `metrics.json`). A JSON file without a schema fails the test.
+
+use std::path::{Path, PathBuf};
+
+fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn schema_file(path: &Path, v: &serde_json::Value) -> Option<&'static str> {
+    let by_field = match v.get("schema").and_then(|s| s.as_str()) {
+        Some("hgym/validation/v1") => Some("validation.schema.json"),
+        Some("hgym/kolmogorov-validation/v1") => Some("kolmogorov-validation.schema.json"),
+        Some("hgym/train/v1") => Some("train.schema.json"),
+        Some("hgym/eval/v1") => Some("eval.schema.json"),
+        Some("hgym/eval-manifest/v1") => Some("eval-manifest.schema.json"),
+        Some("hgym/seeds/v1") => Some("seeds.schema.json"),
+        Some("hgym/comparison/v1") => Some("comparison.schema.json"),
+        Some("hgym/rollout/v1") => Some("rollout.schema.json"),
+        Some(_) => None,
+        None => match path.file_name().and_then(|n| n.to_str()) {
+            Some("policy.json") => Some("policy.schema.json"),
+            Some("metrics.json") if v.get("c_d").is_some() => Some("rollout-metrics.schema.json"),
+            _ => None,
+        },
+    };
+    by_field
+}
+
+fn json_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            json_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "json") {
+            out.push(p);
+        }
+    }
+}
+
+#[test]
+fn every_result_json_matches_its_schema() {
+    let schemas = repo().join("schemas");
+    let mut opts = jsonschema::options();
+    let mut loaded = std::collections::BTreeMap::new();
+    for e in std::fs::read_dir(&schemas).unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(e.path()).unwrap()).unwrap_or_else(|err| panic!("{name}: {err}"));
+        opts = opts.with_resource(
+            format!("https://hgym.dev/schemas/{name}"),
+            jsonschema::Resource::from_contents(v.clone()).unwrap(),
+        );
+        loaded.insert(name, v);
+    }
+    let mut files = vec![];
+    json_files(&repo().join("results"), &mut files);
+    assert!(files.len() > 20, "expected the committed results");
+    let mut counts = std::collections::BTreeMap::new();
+    for f in &files {
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(f).unwrap()).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        let name = schema_file(f, &v).unwrap_or_else(|| panic!("{} has no schema in schemas/", f.display()));
+        let validator = opts.build(&loaded[name]).unwrap_or_else(|e| panic!("{name} does not compile: {e}"));
+        let errors: Vec<String> = validator
+            .iter_errors(&v)
+            .take(5)
+            .map(|e| format!("{e} at {}", e.instance_path))
+            .collect();
+        assert!(errors.is_empty(), "{} does not match schemas/{name}: {errors:?}", f.display());
+        *counts.entry(name).or_insert(0) += 1;
+    }
+    println!("validated {} files: {counts:?}", files.len());
+}
