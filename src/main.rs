@@ -64,6 +64,18 @@ enum Command {
     /// Run a comparison protocol (benchmarks/protocols/*.toml): several algorithms over the same
     /// seeds, and the samples each needs to reach a fraction of the reference's final return.
     Compare(cli::train::CompareArgs),
+    /// Aggregate the result folders under results/ into results/leaderboard.json,
+    /// results/LEADERBOARD.md and a bar chart per environment.
+    Leaderboard {
+        /// Only this environment.
+        #[arg(long)]
+        env: Option<String>,
+        /// The results folder.
+        #[arg(long, default_value = "results")]
+        results: PathBuf,
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 #[derive(Args)]
@@ -222,6 +234,19 @@ fn main() -> ExitCode {
         Command::Train(args) => cli::train::run_train(args),
         Command::Eval(args) => cli::train::run_eval(args),
         Command::Compare(args) => cli::train::run_compare(args),
+        Command::Leaderboard { env, results, json } => {
+            let lb = hgym::report::leaderboard::build(&results, env.as_deref());
+            hgym::report::leaderboard::write(&results, &lb)
+                .map_err(anyhow::Error::msg)
+                .and_then(|_| {
+                    if json {
+                        println!("{}", serde_json::to_string_pretty(&lb)?);
+                    } else {
+                        print!("{}", hgym::report::leaderboard::markdown(&lb));
+                    }
+                    Ok(Outcome::Ok)
+                })
+        }
         Command::Bench(BenchCommand::Agents { json, quick, threads }) => cli::train::run_bench_agents(json, quick, threads),
         Command::Bench(BenchCommand::Kolmogorov { json, quick }) => {
             let b = hgym::bench::kolmogorov::bench_kolmogorov(quick);

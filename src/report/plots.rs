@@ -351,42 +351,46 @@ fn y_hi<DB: DrawingBackend>(
 
 /// Bars with error whiskers (a leaderboard per environment): `(label, mean, std)`.
 pub fn bars(path: &Path, title: &str, y_label: &str, bars: &[(String, f64, f64)]) -> Result<(), String> {
+    use plotters::coord::ranged1d::SegmentValue;
     fonts();
     let root = BitMapBackend::new(path, (200 + 140 * bars.len().max(1) as u32, 600)).into_drawing_area();
     root.fill(&WHITE).map_err(err(path))?;
     let lo = bars.iter().map(|b| b.1 - b.2.abs()).fold(0.0, f64::min);
     let hi = bars.iter().map(|b| b.1 + b.2.abs()).fold(0.0, f64::max);
     let pad = ((hi - lo) * 0.1).max(1e-3);
-    let n = bars.len().max(1);
+    let n = bars.len().max(1) as i32;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 22))
         .margin(14)
         .x_label_area_size(60)
         .y_label_area_size(80)
-        .build_cartesian_2d(0.0..n as f64, (lo - pad)..(hi + pad))
+        .build_cartesian_2d((0..n).into_segmented(), (lo - pad)..(hi + pad))
         .map_err(err(path))?;
     let labels: Vec<String> = bars.iter().map(|b| b.0.clone()).collect();
     chart
         .configure_mesh()
         .disable_x_mesh()
-        .x_labels(n)
-        .x_label_formatter(&|x| labels.get(x.floor() as usize).cloned().unwrap_or_default())
+        .x_labels(bars.len() + 1)
+        .x_label_formatter(&|x| match x {
+            SegmentValue::CenterOf(k) => labels.get(*k as usize).cloned().unwrap_or_default(),
+            _ => String::new(),
+        })
         .y_desc(y_label)
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(err(path))?;
     for (k, (_, mean, std)) in bars.iter().enumerate() {
         let c = PALETTE[k % PALETTE.len()];
-        let x = k as f64;
+        let k = k as i32;
         chart
             .draw_series(std::iter::once(Rectangle::new(
-                [(x + 0.15, 0.0), (x + 0.85, *mean)],
+                [(SegmentValue::Exact(k), 0.0), (SegmentValue::Exact(k + 1), *mean)],
                 c.mix(0.8).filled(),
             )))
             .map_err(err(path))?;
         chart
             .draw_series(std::iter::once(PathElement::new(
-                vec![(x + 0.5, mean - std), (x + 0.5, mean + std)],
+                vec![(SegmentValue::CenterOf(k), mean - std), (SegmentValue::CenterOf(k), mean + std)],
                 BLACK.stroke_width(2),
             )))
             .map_err(err(path))?;

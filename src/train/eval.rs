@@ -10,10 +10,17 @@ use hgym_agents::rollout::{episode, EpisodeStats};
 use hgym_agents::{Env, EnvError};
 use serde::{Deserialize, Serialize};
 
+/// JSON has no NaN: serde_json writes it as `null`; read `null` back as NaN.
+pub fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
 /// Mean and sample standard deviation.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Stat {
+    #[serde(deserialize_with = "nan_if_null")]
     pub mean: f64,
+    #[serde(deserialize_with = "nan_if_null")]
     pub std: f64,
 }
 
@@ -40,16 +47,22 @@ impl Stat {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct EvalEpisode {
     pub seed: u64,
+    #[serde(deserialize_with = "nan_if_null")]
     pub ret: f64,
     pub length: usize,
     pub terminated: bool,
+    #[serde(deserialize_with = "nan_if_null")]
     pub mean_c_d: f64,
     /// Mean C_D of the uncontrolled flow from the same initial state.
+    #[serde(deserialize_with = "nan_if_null")]
     pub uncontrolled_c_d: f64,
     /// `100 (1 - C_D / C_D,uncontrolled)`.
+    #[serde(deserialize_with = "nan_if_null")]
     pub drag_reduction_pct: f64,
+    #[serde(deserialize_with = "nan_if_null")]
     pub mean_abs_c_l: f64,
     /// Mean over steps of the sum of squared normalised actions.
+    #[serde(deserialize_with = "nan_if_null")]
     pub actuation_cost: f64,
 }
 

@@ -1,0 +1,235 @@
+//! `hgym leaderboard`: aggregates result folders into `results/leaderboard.json`,
+//! `results/LEADERBOARD.md` and one bar chart per environment (`results/leaderboard/<ID>.png`).
+//!
+//! Sources: training runs (`results/train/<ID>-<algo>-<level>/seed<S>/` and the runs of
+//! comparison protocols under `results/compare/`), each with `metrics.json` (final deterministic
+//! evaluation) and `manifest.json`; classical baselines evaluated with `hgym eval --out
+//! results/eval` (`results/eval/<ID>-<policy>-<level>/`). Entries are grouped by (environment,
+//! level, algorithm or baseline); per entry: seeds, mean +- std over seeds of the drag reduction
+//! (for flows with a drag coefficient) and of the return, samples, wall time, code versions.
+//! Ranking: by drag reduction where there is one, else by return.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::report::plots;
+use crate::train::eval::{EvalReport, Stat};
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Entry {
+    pub env_id: String,
+    pub level: String,
+    /// The environment spec the runs share (overrides such as another objective change it).
+    pub spec_hash: String,
+    /// Algorithm (`td3`, `ppo`, ...) or baseline (`zero`, `opposition=1`, ...).
+    pub policy: String,
+    pub kind: String,
+    pub seeds: usize,
+    pub drag_reduction_pct: Stat,
+    pub ret: Stat,
+    pub samples: Option<u64>,
+    pub wall_time_s: Option<f64>,
+    pub code_versions: Vec<String>,
+    pub runs: Vec<PathBuf>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Leaderboard {
+    pub schema: String,
+    pub entries: Vec<Entry>,
+}
+
+struct Run {
+    env_id: String,
+    level: String,
+    policy: String,
+    kind: &'static str,
+    report: EvalReport,
+    samples: Option<u64>,
+    wall: Option<f64>,
+    version: Option<String>,
+    dir: PathBuf,
+}
+
+fn read_json(p: &Path) -> Option<serde_json::Value> {
+    serde_json::from_str(&std::fs::read_to_string(p).ok()?).ok()
+}
+
+/// Every folder below `dir` holding a `metrics.json` of the evaluation schema.
+fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let mut entries: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
+    entries.sort();
+    for p in entries {
+        if !p.is_dir() {
+            continue;
+        }
+        let metrics = p.join("metrics.json");
+        if let Some(v) = read_json(&metrics).filter(|v| v["schema"] == "hgym/eval/v1") {
+            let Ok(report) = serde_json::from_value::<EvalReport>(v) else {
+                continue;
+            };
+            let manifest = read_json(&p.join("manifest.json")).unwrap_or_default();
+            let trained = manifest["schema"] == "hgym/train/v1";
+            let policy = if trained {
+                manifest["algo"].as_str().unwrap_or("?").to_string()
+            } else {
+                manifest["policy"].as_str().unwrap_or(&report.policy).to_string()
+            };
+            out.push(Run {
+                env_id: report.env_id.clone(),
+                level: report.level.clone(),
+                policy,
+                kind: if trained { "learned" } else { "baseline" },
+                samples: manifest["samples"].as_u64(),
+                wall: manifest["manifest"]["wall_time_s"].as_f64(),
+                version: manifest["manifest"]["git_commit"]
+                    .as_str()
+                    .map(|c| format!("{} ({c})", manifest["manifest"]["code_version"].as_str().unwrap_or("hgym")))
+                    .or_else(|| manifest["manifest"]["code_version"].as_str().map(|s| s.to_string())),
+                dir: p.strip_prefix(root).unwrap_or(&p).to_path_buf(),
+                report,
+            });
+        } else {
+            collect(&p, root, out);
+        }
+    }
+}
+
+/// Builds the leaderboard from everything under `results` (optionally one environment).
+pub fn build(results: &Path, env: Option<&str>) -> Leaderboard {
+    let mut runs = vec![];
+    collect(results, results.parent().unwrap_or(Path::new(".")), &mut runs);
+    let mut groups: BTreeMap<(String, String, String, String), Vec<Run>> = BTreeMap::new();
+    for r in runs.into_iter().filter(|r| env.is_none_or(|e| r.env_id == e)) {
+        let key = (r.env_id.clone(), r.level.clone(), r.report.spec_hash.clone(), r.policy.clone());
+        groups.entry(key).or_default().push(r);
+    }
+    let mut entries: Vec<Entry> = groups
+        .into_iter()
+        .map(|((env_id, level, spec_hash, policy), runs)| {
+            let col = |f: &dyn Fn(&Run) -> f64| Stat::of(&runs.iter().map(f).collect::<Vec<_>>());
+            let mut versions: Vec<String> = runs.iter().filter_map(|r| r.version.clone()).collect();
+            versions.sort();
+            versions.dedup();
+            let samples: Vec<u64> = runs.iter().filter_map(|r| r.samples).collect();
+            let walls: Vec<f64> = runs.iter().filter_map(|r| r.wall).collect();
+            Entry {
+                kind: runs[0].kind.to_string(),
+                seeds: runs.len(),
+                drag_reduction_pct: col(&|r| r.report.drag_reduction_pct.mean),
+                ret: col(&|r| r.report.ret.mean),
+                samples: (!samples.is_empty()).then(|| samples.iter().sum::<u64>() / samples.len() as u64),
+                wall_time_s: (!walls.is_empty()).then(|| walls.iter().sum::<f64>() / walls.len() as f64),
+                code_versions: versions,
+                runs: runs.iter().map(|r| r.dir.clone()).collect(),
+                env_id,
+                level,
+                spec_hash,
+                policy,
+            }
+        })
+        .collect();
+    let key = |e: &Entry| {
+        let d = e.drag_reduction_pct.mean;
+        if d.is_finite() {
+            d
+        } else {
+            e.ret.mean
+        }
+    };
+    entries.sort_by(|a, b| {
+        (&a.env_id, &a.level, &a.spec_hash)
+            .cmp(&(&b.env_id, &b.level, &b.spec_hash))
+            .then(key(b).total_cmp(&key(a)))
+    });
+    Leaderboard {
+        schema: "hgym/leaderboard/v1".into(),
+        entries,
+    }
+}
+
+fn fmt_stat(s: &Stat, unit: &str) -> String {
+    if s.mean.is_finite() {
+        format!("{:+.2}{unit} ± {:.2}", s.mean, s.std)
+    } else {
+        "–".into()
+    }
+}
+
+/// The markdown table, one section per (environment, level).
+pub fn markdown(lb: &Leaderboard) -> String {
+    let mut s = String::from(
+        "# hgym leaderboard\n\nGenerated by `hgym leaderboard` from the result folders under `results/`. \
+         Drag reduction is against the uncontrolled flow of the same spec from the same initial states \
+         (deterministic evaluation); mean ± std over seeds (learners) or episodes' means (baselines: one entry).\n",
+    );
+    let mut last = (String::new(), String::new(), String::new());
+    let mut rank = 0;
+    for e in &lb.entries {
+        let group = (e.env_id.clone(), e.level.clone(), e.spec_hash.clone());
+        if group != last {
+            last = group;
+            rank = 0;
+            let short = &e.spec_hash[..e.spec_hash.len().min(8)];
+            s += &format!(
+                "\n## {} ({}, spec {short})\n\n![{}](leaderboard/{}-{}-{short}.png)\n\n| rank | policy | kind | seeds | drag reduction | return | samples | wall time | code |\n|---|---|---|---|---|---|---|---|---|\n",
+                e.env_id, e.level, e.env_id, e.env_id, e.level
+            );
+        }
+        rank += 1;
+        s += &format!(
+            "| {rank} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            e.policy,
+            e.kind,
+            e.seeds,
+            fmt_stat(&e.drag_reduction_pct, " %"),
+            fmt_stat(&e.ret, ""),
+            e.samples.map(|v| v.to_string()).unwrap_or_else(|| "–".into()),
+            e.wall_time_s.map(|v| format!("{v:.0} s")).unwrap_or_else(|| "–".into()),
+            e.code_versions.join(", ")
+        );
+    }
+    s
+}
+
+/// Writes `leaderboard.json`, `LEADERBOARD.md` and `leaderboard/<ID>-<level>.png` under `results`.
+pub fn write(results: &Path, lb: &Leaderboard) -> Result<(), String> {
+    let io = |e: std::io::Error| format!("writing the leaderboard under {}: {e}", results.display());
+    std::fs::write(
+        results.join("leaderboard.json"),
+        serde_json::to_string_pretty(lb).map_err(|e| e.to_string())? + "\n",
+    )
+    .map_err(io)?;
+    std::fs::write(results.join("LEADERBOARD.md"), markdown(lb)).map_err(io)?;
+    let dir = results.join("leaderboard");
+    std::fs::create_dir_all(&dir).map_err(io)?;
+    let mut by_env: BTreeMap<(String, String, String), Vec<&Entry>> = BTreeMap::new();
+    for e in &lb.entries {
+        let short = e.spec_hash[..e.spec_hash.len().min(8)].to_string();
+        by_env.entry((e.env_id.clone(), e.level.clone(), short)).or_default().push(e);
+    }
+    for ((env, level, short), es) in by_env {
+        let drag = es.iter().any(|e| e.drag_reduction_pct.mean.is_finite());
+        let bars: Vec<(String, f64, f64)> = es
+            .iter()
+            .map(|e| {
+                let s = if drag { &e.drag_reduction_pct } else { &e.ret };
+                (
+                    e.policy.clone(),
+                    if s.mean.is_finite() { s.mean } else { 0.0 },
+                    if s.std.is_finite() { s.std } else { 0.0 },
+                )
+            })
+            .collect();
+        plots::bars(
+            &dir.join(format!("{env}-{level}-{short}.png")),
+            &format!("{env} ({level}, spec {short})"),
+            if drag { "drag reduction (%)" } else { "evaluation return" },
+            &bars,
+        )?;
+    }
+    Ok(())
+}
