@@ -126,6 +126,9 @@ struct RunArgs {
     /// Parent folder of the result folder.
     #[arg(long, default_value = "results/runs")]
     out: PathBuf,
+    /// TOML file whose [env] table overrides any field of the spec (as `hgym envs show ID` prints it).
+    #[arg(long)]
+    config: Option<PathBuf>,
     #[arg(long)]
     threads: Option<usize>,
 }
@@ -536,7 +539,26 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
 }
 
 fn run_rollout(args: RunArgs) -> Result<Outcome> {
-    let spec = hgym::env::spec(&args.env)?;
+    let config = match &args.config {
+        None => hgym::train::config::TrainConfig::default(),
+        Some(p) => {
+            let text = std::fs::read_to_string(p).with_context(|| format!("cannot read the config file {}", p.display()))?;
+            hgym::train::config::TrainConfig::parse(&text, &p.display().to_string()).map_err(UsageError)?
+        }
+    };
+    let spec = match hgym::train::resolve_spec(&args.env, &config) {
+        Ok(hgym::env::any::AnySpec::Lbm(s)) => s,
+        Ok(other) => {
+            return Err(UsageError(format!(
+                "`hgym run` draws lattice-Boltzmann flows; for {} use `hgym eval --policy zero|random|sine --env {}`",
+                other.id(),
+                other.id()
+            ))
+            .into())
+        }
+        Err(hgym::train::TrainError::Input(m)) => return Err(UsageError(m).into()),
+        Err(e) => return Err(e.into()),
+    };
     if args.steps == 0 {
         return Err(UsageError("--steps must be at least 1".into()).into());
     }
@@ -555,7 +577,10 @@ fn run_rollout(args: RunArgs) -> Result<Outcome> {
         out: out.clone(),
         cache: hgym::env::default_cache_dir(),
     };
-    eprintln!("{}: first use spins the flow up to its attractor (cached afterwards)", spec.id);
+    eprintln!(
+        "{}: starting from the developed flow (spun up once per ID and level, then cached)",
+        spec.id
+    );
     let pb = progress_bar(args.steps as u64, &spec.id);
     let summary = pool
         .install(|| hgym::env::rollout::rollout(&spec, &opts, &mut |k, _| pb.set_position(k as u64)))
