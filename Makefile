@@ -7,8 +7,11 @@ export CARGO_TARGET_DIR
 CARGO ?= cargo
 HGYM := $(CARGO_TARGET_DIR)/release/hgym
 LEVEL ?= default
+# Python tools the tests read our files with (the `mcap` reader), in a venv outside the clone.
+VENV ?= $(HOME)/.cache/hgym-venv
+PYTHON ?= python3
 
-.PHONY: all setup build test validate bench nightly lint fmt clean help
+.PHONY: all setup build test validate bench nightly lint fmt clean help leaderboard
 
 help:
 	@echo "make validate   build, then validate the D2Q9 solver on the cylinder cases (LEVEL=$(LEVEL))"
@@ -16,18 +19,25 @@ help:
 	@echo "make bench      hgym bench lbm: MLUPS against the measured memory bandwidth"
 	@echo "make nightly    long checks: fine-level validation and the benchmark"
 	@echo "make lint       rustfmt and clippy"
+	@echo "make leaderboard  aggregate results/ into results/LEADERBOARD.md"
 
 all: build
 
-setup:
+setup: $(VENV)/.installed
 	@command -v $(CARGO) >/dev/null || { echo "cargo not found: install Rust from https://rustup.rs"; exit 2; }
 	@command -v cc >/dev/null || { echo "a C compiler (gcc) is needed for some crates"; exit 2; }
+
+$(VENV)/.installed: Makefile
+	@command -v $(PYTHON) >/dev/null || { echo "python3 not found (Python 3.11 is assumed)"; exit 2; }
+	$(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check "mcap>=1.2,<2"
+	@touch $@
 
 build: setup
 	$(CARGO) build --release --locked
 
 test: setup
-	$(CARGO) test --release --locked --workspace -- --show-output
+	HGYM_PYTHON=$(VENV)/bin/python $(CARGO) test --release --locked --workspace -- --show-output
 
 validate: build
 	$(HGYM) validate cylinder --level $(LEVEL)
@@ -38,6 +48,10 @@ bench: build
 nightly: build
 	$(HGYM) validate cylinder --level fine --out results/nightly/validation
 	$(HGYM) bench lbm
+
+leaderboard: build
+	$(HGYM) leaderboard > /dev/null
+	@echo "wrote results/leaderboard.json, results/LEADERBOARD.md, results/leaderboard/*.png"
 
 lint:
 	$(CARGO) fmt --all -- --check

@@ -9,6 +9,7 @@
 //! and are converted by [`hgym_solvers::lbm::Units`].
 
 pub mod bench;
+pub mod data;
 pub mod env;
 pub mod report;
 pub mod train;

@@ -64,6 +64,10 @@ enum Command {
     /// Run a comparison protocol (benchmarks/protocols/*.toml): several algorithms over the same
     /// seeds, and the samples each needs to reach a fraction of the reference's final return.
     Compare(cli::train::CompareArgs),
+    /// Trajectory files: `hgym data recover FILE` salvages every complete chunk of a truncated
+    /// MCAP file (e.g. after a kill) into FILE.recovered.mcap.
+    #[command(subcommand)]
+    Data(DataCommand),
     /// Aggregate the result folders under results/ into results/leaderboard.json,
     /// results/LEADERBOARD.md and a bar chart per environment.
     Leaderboard {
@@ -207,6 +211,19 @@ enum BenchCommand {
     },
 }
 
+#[derive(Subcommand)]
+enum DataCommand {
+    /// Copy every complete chunk (and the metadata) of a damaged MCAP file into a valid one.
+    Recover {
+        file: PathBuf,
+        /// Output file (default: <file>.recovered.mcap).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        #[arg(long)]
+        json: bool,
+    },
+}
+
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum CollisionArg {
     Bgk,
@@ -237,6 +254,30 @@ fn main() -> ExitCode {
         Command::Train(args) => cli::train::run_train(args),
         Command::Eval(args) => cli::train::run_eval(args),
         Command::Compare(args) => cli::train::run_compare(args),
+        Command::Data(DataCommand::Recover { file, out, json }) => {
+            let out = out.unwrap_or_else(|| file.with_extension("recovered.mcap"));
+            match hgym::data::trajectory::recover(&file, &out) {
+                Ok(r) => {
+                    if json {
+                        println!("{}", serde_json::to_string_pretty(&r).unwrap_or_default());
+                    } else {
+                        println!(
+                            "recovered {} messages and {} metadata records from {} into {}{}",
+                            r.messages,
+                            r.metadata,
+                            file.display(),
+                            out.display(),
+                            r.stopped_at
+                                .as_ref()
+                                .map(|e| format!("\n  lost: everything after the last complete chunk (reading stopped: {e})"))
+                                .unwrap_or_else(|| "\n  nothing lost: the file was complete".into())
+                        );
+                    }
+                    Ok(Outcome::Ok)
+                }
+                Err(e) => Err(UsageError(e).into()),
+            }
+        }
         Command::Leaderboard { env, results, json } => {
             let lb = hgym::report::leaderboard::build(&results, env.as_deref());
             hgym::report::leaderboard::write(&results, &lb)
@@ -582,8 +623,13 @@ fn run_rollout(args: RunArgs) -> Result<Outcome> {
         spec.id
     );
     let pb = progress_bar(args.steps as u64, &spec.id);
+    cli::train::install_interrupt();
     let summary = pool
-        .install(|| hgym::env::rollout::rollout(&spec, &opts, &mut |k, _| pb.set_position(k as u64)))
+        .install(|| {
+            hgym::env::rollout::rollout(&spec, &opts, &mut |k, _| pb.set_position(k as u64), &|| {
+                cli::train::INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst)
+            })
+        })
         .with_context(|| format!("running {}", spec.id))?;
     pb.finish_and_clear();
     println!(
@@ -596,6 +642,13 @@ fn run_rollout(args: RunArgs) -> Result<Outcome> {
         if summary.terminated { " (terminated: solver diverged)" } else { "" }
     );
     println!("  results: {}", out.display());
+    if cli::train::INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst) {
+        eprintln!(
+            "interrupted: the partial episode and its trajectory.mcap (complete and valid) are in {}",
+            out.display()
+        );
+        std::process::exit(130);
+    }
     Ok(if summary.terminated { Outcome::CheckFailed } else { Outcome::Ok })
 }
 

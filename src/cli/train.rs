@@ -102,12 +102,12 @@ pub struct EvalArgs {
     threads: Option<usize>,
 }
 
-static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 static SIGNALS: AtomicUsize = AtomicUsize::new(0);
 
 /// First Ctrl-C: finish the current round, write the checkpoint, exit 130. Second: exit now
 /// (the last checkpoint stays valid: checkpoints are replaced atomically).
-fn install_interrupt() {
+pub fn install_interrupt() {
     let _ = ctrlc::set_handler(|| {
         INTERRUPTED.store(true, Ordering::SeqCst);
         if SIGNALS.fetch_add(1, Ordering::SeqCst) >= 1 {
@@ -357,6 +357,29 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
     let started = std::time::Instant::now();
     let seeds: Vec<u64> = (0..args.episodes as u64).map(|k| args.eval_seed + k).collect();
     let pb = progress_bar(2 * args.episodes as u64, spec.id());
+    let slug: String = args
+        .policy
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '.' { c } else { '_' })
+        .collect();
+    let out_dir = args
+        .out
+        .as_ref()
+        .map(|o| o.join(format!("{}-{}-{}", spec.id(), slug, args.level.name())));
+    let mut trajectory = match &out_dir {
+        Some(dir) => {
+            std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+            Some(
+                hgym::data::trajectory::TrajectoryWriter::create(
+                    &dir.join("trajectory.mcap"),
+                    spec.control_interval(),
+                    spec.trajectory_manifest(args.level, &args.policy, &seeds),
+                )
+                .map_err(anyhow::Error::msg)?,
+            )
+        }
+        None => None,
+    };
     let report: EvalReport = pool
         .install(|| -> Result<EvalReport> {
             let mut env = spec.make(args.level, hgym::env::default_cache_dir())?;
@@ -372,6 +395,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
                 args.level.name(),
                 &seeds,
                 &reference,
+                trajectory.as_mut(),
                 &mut |k| pb.set_position((args.episodes + k) as u64),
             )?)
         })

@@ -73,6 +73,33 @@ impl AnySpec {
         }
     }
 
+    /// Physical time between actions.
+    pub fn control_interval(&self) -> f64 {
+        match self {
+            AnySpec::Lbm(s) => s.control_interval,
+            AnySpec::Kolmogorov(s) => s.control_interval,
+        }
+    }
+
+    /// The metadata record of a trajectory file: spec, hash, level, policy, seeds, code version.
+    pub fn trajectory_manifest(&self, level: Level, policy: &str, seeds: &[u64]) -> std::collections::BTreeMap<String, String> {
+        let m = crate::report::manifest::manifest(rayon::current_num_threads(), 0.0);
+        [
+            ("env_id", self.id().to_string()),
+            ("spec_hash", self.hash()),
+            ("spec", serde_json::to_string(self).unwrap_or_default()),
+            ("level", level.name().to_string()),
+            ("policy", policy.to_string()),
+            ("seeds", format!("{seeds:?}")),
+            ("code_version", m.code_version),
+            ("git_commit", m.git_commit.unwrap_or_default()),
+            ("control_interval", self.control_interval().to_string()),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect()
+    }
+
     pub fn to_toml(&self) -> String {
         match self {
             AnySpec::Lbm(s) => s.to_toml(),

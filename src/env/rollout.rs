@@ -80,12 +80,27 @@ impl Rng {
 
 /// Runs one episode (at most `actions` actions) and writes `<out>/manifest.json`,
 /// `metrics.json`, `rollout.png` and `vorticity.png`.
-pub fn rollout(spec: &EnvSpec, opts: &RolloutOptions, progress: &mut dyn FnMut(usize, usize)) -> Result<RolloutManifest, EnvError> {
+pub fn rollout(
+    spec: &EnvSpec,
+    opts: &RolloutOptions,
+    progress: &mut dyn FnMut(usize, usize),
+    stop: &dyn Fn() -> bool,
+) -> Result<RolloutManifest, EnvError> {
     let started = Instant::now();
     let mut spec_run = spec.clone();
     spec_run.episode_actions = opts.actions.max(1);
     let mut env = LbmEnv::new(spec_run, opts.level, opts.cache.clone())?;
-    env.reset(opts.seed)?;
+    let (obs0, info0) = env.reset(opts.seed)?;
+    std::fs::create_dir_all(&opts.out).map_err(|e| EnvError::Backend(format!("cannot create {}: {e}", opts.out.display())))?;
+    let any = crate::env::any::AnySpec::Lbm(spec.clone());
+    let policy_name = format!("{:?}", opts.policy).to_lowercase();
+    let mut trajectory = crate::data::trajectory::TrajectoryWriter::create(
+        &opts.out.join("trajectory.mcap"),
+        spec.control_interval,
+        any.trajectory_manifest(opts.level, &policy_name, &[opts.seed]),
+    )
+    .map_err(EnvError::Backend)?;
+    trajectory.reset(&obs0, &info0).map_err(EnvError::Backend)?;
     let dim = spec.act_dim();
     let mut rng = Rng(opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
     let mut m = Metrics {
@@ -103,6 +118,7 @@ pub fn rollout(spec: &EnvSpec, opts: &RolloutOptions, progress: &mut dyn FnMut(u
             Policy::Sine => vec![(2.0 * std::f64::consts::PI * k as f64 / 20.0).sin(); dim],
         };
         let r = env.step(&a)?;
+        trajectory.step(&a, &r).map_err(EnvError::Backend)?;
         m.t.push(r.info.get("t").unwrap_or(0.0));
         m.reward.push(r.reward);
         m.c_d.push(r.info.get("C_D").unwrap_or(f64::NAN));
@@ -120,7 +136,12 @@ pub fn rollout(spec: &EnvSpec, opts: &RolloutOptions, progress: &mut dyn FnMut(u
             truncated = true;
             break;
         }
+        if stop() {
+            message = Some(format!("interrupted after {} actions", k + 1));
+            break;
+        }
     }
+    trajectory.finish().map_err(EnvError::Backend)?;
     let n = m.reward.len();
     let summary = RolloutManifest {
         schema: "hgym/rollout/v1".into(),

@@ -97,6 +97,7 @@ pub fn uncontrolled_return(p: &Protocol) -> Result<f64, String> {
         p.level.name(),
         &seeds,
         &refs,
+        None,
         &mut |_| {},
     )
     .map_err(|e| e.to_string())?;

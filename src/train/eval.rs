@@ -6,7 +6,9 @@ use std::path::Path;
 
 use hgym_agents::baselines::{Baseline, BaselinePolicy, Signal};
 use hgym_agents::policy::{ActorPolicy, Policy};
-use hgym_agents::rollout::{episode, EpisodeStats};
+use hgym_agents::rollout::{episode, EpisodeAccumulator, EpisodeStats};
+
+use crate::data::trajectory::TrajectoryWriter;
 use hgym_agents::{Env, EnvError};
 use serde::{Deserialize, Serialize};
 
@@ -108,12 +110,36 @@ pub fn evaluate<E: Env + ?Sized>(
     level: &str,
     seeds: &[u64],
     reference: &[f64],
+    mut trajectory: Option<&mut TrajectoryWriter>,
     progress: &mut dyn FnMut(usize),
 ) -> Result<EvalReport, EnvError> {
     let mut episodes = vec![];
+    let io = |e: String| EnvError::Backend(e);
     for (k, (seed, c_d0)) in seeds.iter().zip(reference).enumerate() {
         let mut cost = 0.0;
-        let stats: EpisodeStats = episode(env, policy, *seed, &mut |a, _| cost += a.iter().map(|v| v * v).sum::<f64>())?;
+        let (mut obs, mut info) = env.reset(*seed)?;
+        if let Some(t) = trajectory.as_deref_mut() {
+            t.reset(&obs, &info).map_err(io)?;
+        }
+        policy.reset();
+        let mut action = vec![0.0; env.action_space().dim()];
+        let mut acc = EpisodeAccumulator::default();
+        loop {
+            policy.act(&obs, &info, &mut action);
+            let r = env.step(&action)?;
+            cost += action.iter().map(|v| v * v).sum::<f64>();
+            if let Some(t) = trajectory.as_deref_mut() {
+                t.step(&action, &r).map_err(io)?;
+            }
+            acc.add(&r);
+            let done = r.terminated || r.truncated;
+            obs = r.obs;
+            info = r.info;
+            if done {
+                break;
+            }
+        }
+        let stats: EpisodeStats = acc.finish();
         let mean_c_d = stats.info_means.get("C_D").copied().unwrap_or(f64::NAN);
         episodes.push(EvalEpisode {
             seed: *seed,

@@ -201,6 +201,7 @@ pub fn train(
                 opts.level.name(),
                 &periodic_seeds,
                 &reference,
+                None,
                 &mut |_| {},
             )?;
             row.eval_return = r.ret.mean;
@@ -230,6 +231,12 @@ pub fn train(
     let final_ref = uncontrolled_c_d(&mut eval_env, &final_seeds)?;
     let mut policy = learner.policy();
     let hash = spec.hash();
+    let mut trajectory = crate::data::trajectory::TrajectoryWriter::create(
+        &opts.out.join("trajectory.mcap"),
+        spec.control_interval(),
+        spec.trajectory_manifest(opts.level, opts.algo.name(), &final_seeds),
+    )
+    .map_err(TrainError::Io)?;
     let report = evaluate(
         &mut eval_env,
         &mut policy,
@@ -239,8 +246,10 @@ pub fn train(
         opts.level.name(),
         &final_seeds,
         &final_ref,
+        Some(&mut trajectory),
         &mut |_| {},
     )?;
+    trajectory.finish().map_err(TrainError::Io)?;
     let io = |e: std::io::Error| TrainError::Io(format!("writing results to {}: {e}", opts.out.display()));
     let json = |v: &dyn erased::Json| v.to_json();
     std::fs::write(opts.out.join("policy.json"), json(&policy) + "\n").map_err(io)?;
