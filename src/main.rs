@@ -353,10 +353,10 @@ fn progress_bar(total: u64, label: &str) -> ProgressBar {
 fn run_validate(args: ValidateArgs) -> Result<Outcome> {
     if args.family.as_deref() == Some("kolmogorov") {
         let (pool, _) = thread_pool(args.threads)?;
-        let time = 2000.0;
-        let pb = progress_bar((time / 0.5) as u64, "kolmogorov Re 40");
+        let case = hgym::validate::kolmogorov::case().map_err(UsageError)?;
+        let pb = progress_bar((case.time / case.sample_interval) as u64, "kolmogorov Re 40");
         let r = pool
-            .install(|| hgym::validate::kolmogorov::validate(args.level, time, &args.out, &mut |k, _| pb.set_position(k as u64)))
+            .install(|| hgym::validate::kolmogorov::validate(args.level, &args.out, &mut |k, _| pb.set_position(k as u64)))
             .context("Kolmogorov validation")?;
         pb.finish_and_clear();
         if args.json {
