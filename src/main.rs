@@ -68,6 +68,22 @@ enum Command {
     /// MCAP file (e.g. after a kill) into FILE.recovered.mcap.
     #[command(subcommand)]
     Data(DataCommand),
+    /// Learning curves of several training runs in one figure (evaluation return, or drag
+    /// reduction with --drag), e.g. `hgym plot results/train/Cylinder_2D_Re100-*/seed0 -o cmp.png`.
+    Plot {
+        /// Training result folders (each with curve.csv).
+        #[arg(required = true)]
+        runs: Vec<PathBuf>,
+        /// Output PNG.
+        #[arg(short, long, default_value = "learning_curves.png")]
+        out: PathBuf,
+        /// Plot the evaluation drag reduction instead of the return.
+        #[arg(long)]
+        drag: bool,
+        /// Plot the training return (with exploration) instead of the evaluation return.
+        #[arg(long)]
+        train: bool,
+    },
     /// Aggregate the result folders under results/ into results/leaderboard.json,
     /// results/LEADERBOARD.md and a bar chart per environment.
     Leaderboard {
@@ -278,6 +294,7 @@ fn main() -> ExitCode {
                 Err(e) => Err(UsageError(e).into()),
             }
         }
+        Command::Plot { runs, out, drag, train } => run_plot(&runs, &out, drag, train),
         Command::Leaderboard { env, results, json } => {
             let lb = hgym::report::leaderboard::build(&results, env.as_deref());
             hgym::report::leaderboard::write(&results, &lb)
@@ -673,5 +690,64 @@ fn run_bench_envs(json: bool, actions: usize, quick: bool) -> Result<Outcome> {
     } else {
         print!("{}", hgym::bench::envs::table(&rows));
     }
+    Ok(Outcome::Ok)
+}
+
+fn run_plot(runs: &[PathBuf], out: &std::path::Path, drag: bool, train: bool) -> Result<Outcome> {
+    use hgym::report::plots::{lines, Line};
+    let mut series: Vec<(String, Vec<f64>, Vec<f64>)> = vec![];
+    for dir in runs {
+        let file = dir.join("curve.csv");
+        let text = std::fs::read_to_string(&file).map_err(|e| {
+            UsageError(format!(
+                "{}: {e} (give training result folders, each with curve.csv)",
+                file.display()
+            ))
+        })?;
+        let rows = hgym::train::curve::from_csv(&text).map_err(|e| UsageError(format!("{}: {e}", file.display())))?;
+        let (x, y): (Vec<f64>, Vec<f64>) = rows
+            .iter()
+            .map(|r| {
+                let y = if drag {
+                    r.eval_drag_reduction_pct
+                } else if train {
+                    r.train_return
+                } else {
+                    r.eval_return
+                };
+                (r.samples as f64, y)
+            })
+            .filter(|(_, y)| y.is_finite())
+            .unzip();
+        let label = dir
+            .components()
+            .rev()
+            .take(2)
+            .map(|c| c.as_os_str().to_string_lossy().into_owned())
+            .collect::<Vec<_>>()
+            .into_iter()
+            .rev()
+            .collect::<Vec<_>>()
+            .join("/");
+        series.push((label, x, y));
+    }
+    let lines_: Vec<Line> = series
+        .iter()
+        .map(|(l, x, y)| Line {
+            label: l,
+            x,
+            y,
+            band: None,
+        })
+        .collect();
+    let what = if drag {
+        "evaluation drag reduction (%)"
+    } else if train {
+        "training return"
+    } else {
+        "evaluation return"
+    };
+    lines(out, "learning curves", "environment samples", what, &lines_).map_err(anyhow::Error::msg)?;
+    println!("wrote {} ({} runs)", out.display(), series.len());
     Ok(Outcome::Ok)
 }

@@ -212,3 +212,25 @@ fn bad_training_input_is_named() {
     assert!(o.status.success());
     assert!(text(&o).contains("[td3]") && text(&o).contains("policy_delay"));
 }
+
+#[test]
+fn plot_draws_several_committed_runs_and_names_bad_folders() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("c.png");
+    let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let a = repo.join("results/train/Cylinder_2D_Re100-td3-coarse/seed0");
+    let b = repo.join("results/train/Cylinder_2D_Re100-ppo-coarse/seed0");
+    let o = hgym(&[
+        "plot",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--drag",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(std::fs::metadata(&out).unwrap().len() > 10_000);
+    let o = hgym(&["plot", tmp.path().to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).contains("curve.csv"), "{}", text(&o));
+}
