@@ -17,7 +17,7 @@ help:
 	@echo "make validate   build, then validate the D2Q9 solver on the cylinder cases (LEVEL=$(LEVEL))"
 	@echo "make test       unit, exact-solution, CLI and schema tests (coarse, fast)"
 	@echo "make bench      hgym bench lbm: MLUPS against the measured memory bandwidth"
-	@echo "make nightly    long checks: fine-level validation and the benchmark"
+	@echo "make nightly    validations (default level), benchmarks, short trainings, leaderboard; results/nightly/summary.md"
 	@echo "make lint       rustfmt and clippy"
 	@echo "make leaderboard  aggregate results/ into results/LEADERBOARD.md"
 
@@ -46,8 +46,7 @@ bench: build
 	$(HGYM) bench lbm
 
 nightly: build
-	$(HGYM) validate cylinder --level fine --out results/nightly/validation
-	$(HGYM) bench lbm
+	HGYM=$(HGYM) scripts/nightly.sh
 
 leaderboard: build
 	$(HGYM) leaderboard > /dev/null

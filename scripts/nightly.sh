@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# `make nightly`: long checks refreshed under results/, then a summary of what changed since the
+# last committed results. Every step runs even if an earlier one fails; the exit code is the
+# number of failed steps (0 = all passed).
+set -uo pipefail
+cd "$(dirname "$0")/.."
+HGYM=${HGYM:-${CARGO_TARGET_DIR:-$HOME/.cache/hgym-target}/release/hgym}
+OUT=results/nightly
+mkdir -p "$OUT"
+LOG="$OUT/log.txt"
+: > "$LOG"
+failed=0
+start=$(date +%s)
+step() {
+  local name=$1; shift
+  local t0=$(date +%s)
+  echo "== $name: $*" | tee -a "$LOG"
+  if "$@" > "$OUT/$name.txt" 2>>"$LOG"; then status=ok; else status="FAILED ($?)"; failed=$((failed + 1)); fi
+  echo "   $status in $(( $(date +%s) - t0 )) s" | tee -a "$LOG"
+}
+step validate-cylinder "$HGYM" validate cylinder --level default
+step validate-pinball  "$HGYM" validate pinball --level default
+step validate-kolmogorov "$HGYM" validate kolmogorov
+step bench-lbm        "$HGYM" bench lbm
+step bench-agents     "$HGYM" bench agents
+step bench-kolmogorov "$HGYM" bench kolmogorov
+step bench-envs       "$HGYM" bench envs --quick
+for algo in ppo ddpg td3 gppo; do
+  step "train-$algo" "$HGYM" train --env Kolmogorov_2D_Re40 --algo "$algo" --steps 2000 --out "$OUT/train"
+done
+step leaderboard "$HGYM" leaderboard
+total=$(( $(date +%s) - start ))
+{
+  echo "# nightly $(date -u +%Y-%m-%dT%H:%MZ), $(git rev-parse --short HEAD 2>/dev/null), ${total} s, ${failed} failed step(s)"
+  echo
+  grep -E "^(==|   )" "$LOG"
+  echo
+  echo "## changed since the last committed results (git diff --stat -- results/)"
+  git diff --stat -- results/ | tail -25
+  echo
+  echo "## leaderboard lines that changed"
+  git diff -U0 -- results/LEADERBOARD.md | grep -E "^[-+]\|" || echo "(none)"
+  echo
+  echo "## validation status"
+  grep -hE "^\s*(pass|FAIL)|^[a-z_0-9]+ \(" "$OUT"/validate-*.txt | head -40
+} > "$OUT/summary.md"
+cat "$OUT/summary.md"
+exit "$failed"
