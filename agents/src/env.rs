@@ -57,6 +57,24 @@ pub enum EnvError {
     Backend(String),
 }
 
+/// The contract's action check, shared by every environment: the length must match the space,
+/// NaN or infinite components are an error, finite values outside the box are clipped. Returns
+/// the clipped action and how many components were clipped.
+pub fn checked_action(space: &BoxSpace, action: &[f64]) -> Result<(Vec<f64>, usize), EnvError> {
+    if action.len() != space.dim() {
+        return Err(EnvError::ActionShape {
+            expected: space.dim(),
+            got: action.len(),
+        });
+    }
+    if let Some((index, value)) = action.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(EnvError::NonFiniteAction { index, value: *value });
+    }
+    let mut a = action.to_vec();
+    let clipped = space.clip(&mut a);
+    Ok((a, clipped))
+}
+
 /// A reinforcement-learning environment.
 pub trait Env {
     fn observation_space(&self) -> BoxSpace;

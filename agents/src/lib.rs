@@ -28,5 +28,5 @@ mod spaces;
 pub mod td3;
 pub mod toy;
 
-pub use env::{DifferentiableEnv, Env, EnvError, Info, StepResult};
+pub use env::{checked_action, DifferentiableEnv, Env, EnvError, Info, StepResult};
 pub use spaces::BoxSpace;

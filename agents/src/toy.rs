@@ -1,6 +1,6 @@
 //! Cheap control tasks for testing learners in seconds (no flows: they live in `hgym`).
 
-use crate::env::{DifferentiableEnv, Env, EnvError, Info, StepResult};
+use crate::env::{checked_action, DifferentiableEnv, Env, EnvError, Info, StepResult};
 use crate::rng::Rng;
 use crate::spaces::BoxSpace;
 
@@ -67,19 +67,8 @@ impl Env for Oscillator {
         if !self.live {
             return Err(EnvError::NeedsReset);
         }
-        if action.len() != 1 {
-            return Err(EnvError::ActionShape {
-                expected: 1,
-                got: action.len(),
-            });
-        }
-        if !action[0].is_finite() {
-            return Err(EnvError::NonFiniteAction {
-                index: 0,
-                value: action[0],
-            });
-        }
-        let u = action[0].clamp(-1.0, 1.0);
+        let (a, clipped) = checked_action(&self.action_space(), action)?;
+        let u = a[0];
         self.history.push((self.x, self.v, u));
         let (w, z) = (self.omega, self.zeta);
         self.v += self.dt * (-w * w * self.x + 2.0 * z * w * self.v + self.gain * u);
@@ -92,7 +81,7 @@ impl Env for Oscillator {
         let mut info = Info::default();
         info.set("t", self.k as f64 * self.dt);
         info.set("x", self.x);
-        info.set("clipped", if u != action[0] { 1.0 } else { 0.0 });
+        info.set("clipped", clipped as f64);
         if terminated {
             info.set_text("reason", "|x| exceeded 10");
         }

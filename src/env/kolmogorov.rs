@@ -23,7 +23,7 @@
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
 
-use hgym_agents::{BoxSpace, DifferentiableEnv, Env, EnvError, Info, StepResult};
+use hgym_agents::{checked_action, BoxSpace, DifferentiableEnv, Env, EnvError, Info, StepResult};
 use hgym_solvers::spectral::{Complex64 as C, Kolmogorov, KolmogorovConfig};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -309,18 +309,18 @@ impl KolmogorovEnv {
         obs
     }
 
-    /// The per-substep flow term of the reward at state `w` (before the 1/M average).
-    fn flow_term(&self, w: &[C]) -> f64 {
+    /// The per-substep flow term of the reward from that substep's dissipation rate and TKE
+    /// (before the 1/M average).
+    fn flow_term(&self, dissipation: f64, tke: f64) -> f64 {
         match self.spec.objective {
             Objective::Dissipation { extreme_weight } => {
-                let e = self.solver.dissipation_of(w);
-                -(e + extreme_weight * (e - self.theta).max(0.0)) / self.spec.dissipation_laminar()
+                -(dissipation + extreme_weight * (dissipation - self.theta).max(0.0)) / self.spec.dissipation_laminar()
             }
-            Objective::Mixing => self.solver.tke_of(w) / self.tke_ref,
+            Objective::Mixing => tke / self.tke_ref,
         }
     }
 
-    /// Adds `scale * d(flow_term)/dw` to `out`.
+    /// Adds `scale * d(flow_term)/dw` at state `w` to `out`.
     fn add_flow_gradient(&self, w: &[C], scale: f64, out: &mut [C]) {
         match self.spec.objective {
             Objective::Dissipation { extreme_weight } => {
@@ -377,18 +377,7 @@ impl Env for KolmogorovEnv {
         if !self.live {
             return Err(EnvError::NeedsReset);
         }
-        let dim = self.spec.act_dim();
-        if action.len() != dim {
-            return Err(EnvError::ActionShape {
-                expected: dim,
-                got: action.len(),
-            });
-        }
-        if let Some((index, value)) = action.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(EnvError::NonFiniteAction { index, value: *value });
-        }
-        let mut a = action.to_vec();
-        let clipped = self.action_space().clip(&mut a);
+        let (a, clipped) = checked_action(&self.action_space(), action)?;
         let physical: Vec<f64> = a.iter().map(|v| v * self.spec.max_amplitude).collect();
         self.history.push(Record {
             start: self.solver.omega.clone(),
@@ -403,11 +392,11 @@ impl Env for KolmogorovEnv {
                 failure = Some(e.to_string());
                 break;
             }
-            let e = self.solver.dissipation();
+            let (e, k) = (self.solver.dissipation(), self.solver.tke());
             eps += e / m as f64;
             excess += (e - self.theta).max(0.0) / m as f64;
-            tke += self.solver.tke() / m as f64;
-            flow += self.flow_term(&self.solver.omega) / m as f64;
+            tke += k / m as f64;
+            flow += self.flow_term(e, k) / m as f64;
         }
         let t = self.history.len() as f64 * self.spec.control_interval;
         let mut info = Info::default();

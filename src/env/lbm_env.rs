@@ -15,7 +15,7 @@
 
 use std::path::PathBuf;
 
-use hgym_agents::{BoxSpace, Env, EnvError, Info, StepResult};
+use hgym_agents::{checked_action, BoxSpace, Env, EnvError, Info, StepResult};
 use hgym_solvers::lbm::{D2q9, D2q9Config, Grid, Units};
 
 use super::actuation::{apply, Jet, WallMotion};
@@ -290,18 +290,7 @@ impl Env for LbmEnv {
         if !self.live {
             return Err(EnvError::NeedsReset);
         }
-        let dim = self.spec.act_dim();
-        if action.len() != dim {
-            return Err(EnvError::ActionShape {
-                expected: dim,
-                got: action.len(),
-            });
-        }
-        if let Some((index, value)) = action.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(EnvError::NonFiniteAction { index, value: *value });
-        }
-        let mut a = action.to_vec();
-        let clipped = self.action_space().clip(&mut a);
+        let (a, clipped) = checked_action(&self.action_space(), action)?;
         let bound = self.bound();
         let a_new: Vec<f64> = a.iter().map(|v| v * bound).collect();
         let n_bodies = self.spec.bodies.len();
