@@ -7,7 +7,8 @@ export CARGO_TARGET_DIR
 CARGO ?= cargo
 HGYM := $(CARGO_TARGET_DIR)/release/hgym
 LEVEL ?= default
-# Python tools the tests read our files with (the `mcap` reader), in a venv outside the clone.
+# Python tools the tests read our files with (the `mcap` reader; pandas, pyarrow and `datasets`
+# for exported Parquet datasets), in a venv outside the clone.
 VENV ?= $(HOME)/.cache/hgym-venv
 PYTHON ?= python3
 
@@ -30,7 +31,7 @@ setup: $(VENV)/.installed
 $(VENV)/.installed: Makefile
 	@command -v $(PYTHON) >/dev/null || { echo "python3 not found (Python 3.11 is assumed)"; exit 2; }
 	$(PYTHON) -m venv $(VENV)
-	$(VENV)/bin/pip install --quiet --disable-pip-version-check "mcap>=1.2,<2"
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check "mcap>=1.2,<2" "pandas>=2" "pyarrow>=15" "datasets>=2.19" pyyaml
 	@touch $@
 
 build: setup

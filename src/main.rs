@@ -68,6 +68,12 @@ enum Command {
     /// MCAP file (e.g. after a kill) into FILE.recovered.mcap.
     #[command(subcommand)]
     Data(DataCommand),
+    /// Turn trajectory files into a dataset: `hgym export --to hf results/train OUT` writes
+    /// Parquet shards (one row per control step, one config per env) and a dataset card.
+    Export(cli::data::ExportArgs),
+    /// Upload a dataset folder to the Hugging Face Hub (token from HF_TOKEN or the
+    /// huggingface-cli token file; endpoint from HF_ENDPOINT).
+    Push(cli::data::PushArgs),
     /// Learning curves of several training runs in one figure (evaluation return, or drag
     /// reduction with --drag), e.g. `hgym plot results/train/Cylinder_2D_Re100-*/seed0 -o cmp.png`.
     Plot {
@@ -149,6 +155,10 @@ struct RunArgs {
     /// TOML file whose [env] table overrides any field of the spec (as `hgym envs show ID` prints it).
     #[arg(long)]
     config: Option<PathBuf>,
+    /// Write flow-field snapshots (u, v, vorticity; foxglove.Grid on /field) into
+    /// trajectory.mcap at reset and every K actions (0: none).
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    fields_every: u64,
     #[arg(long)]
     threads: Option<usize>,
 }
@@ -270,6 +280,8 @@ fn main() -> ExitCode {
         Command::Train(args) => cli::train::run_train(args),
         Command::Eval(args) => cli::train::run_eval(args),
         Command::Compare(args) => cli::train::run_compare(args),
+        Command::Export(args) => cli::data::run_export(args),
+        Command::Push(args) => cli::data::run_push(args),
         Command::Data(DataCommand::Recover { file, out, json }) => {
             let out = out.unwrap_or_else(|| file.with_extension("recovered.mcap"));
             match hgym::data::trajectory::recover(&file, &out) {
@@ -634,6 +646,7 @@ fn run_rollout(args: RunArgs) -> Result<Outcome> {
         policy: args.policy,
         out: out.clone(),
         cache: hgym::env::default_cache_dir(),
+        fields_every: args.fields_every,
     };
     eprintln!(
         "{}: starting from the developed flow (spun up once per ID and level, then cached)",

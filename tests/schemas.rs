@@ -19,6 +19,7 @@ fn schema_file(path: &Path, v: &serde_json::Value) -> Option<&'static str> {
         Some("hgym/comparison/v1") => Some("comparison.schema.json"),
         Some("hgym/rollout/v1") => Some("rollout.schema.json"),
         Some("hgym/leaderboard/v1") => Some("leaderboard.schema.json"),
+        Some("hgym/hf-export/v1") => Some("hf-export.schema.json"),
         Some(_) => None,
         None => match path.file_name().and_then(|n| n.to_str()) {
             Some("policy.json") => Some("policy.schema.json"),

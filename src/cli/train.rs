@@ -93,9 +93,14 @@ pub struct EvalArgs {
     /// TOML file whose [env] table overrides the environment spec.
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Also write the report to <out>/<ID>-<policy>-<level>/metrics.json (+ manifest.json).
+    /// Also write the report to <out>/<ID>-<policy>-<level>/metrics.json (+ manifest.json) and
+    /// the episodes to trajectory.mcap.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Flow-field snapshots (u, v, vorticity) in trajectory.mcap at each reset and every K
+    /// actions (0: none; needs --out).
+    #[arg(long, value_name = "K", default_value_t = 0, requires = "out")]
+    fields_every: u64,
     #[arg(long)]
     json: bool,
     #[arg(long)]
@@ -375,7 +380,8 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
                     spec.control_interval(),
                     spec.trajectory_manifest(args.level, &args.policy, &seeds),
                 )
-                .map_err(anyhow::Error::msg)?,
+                .map_err(anyhow::Error::msg)?
+                .with_fields(args.fields_every),
             )
         }
         None => None,

@@ -5,6 +5,8 @@
 //! its hash, seeds, policy and code version. Chunks are zstd-compressed and closed at the end
 //! of every episode, so a killed writer loses at most the episode in progress (`recover`
 //! salvages every complete chunk); `finish` writes the summary and index.
+//! With [`TrajectoryWriter::with_fields`], a fifth channel `/field` holds flow-field snapshots
+//! (`foxglove.Grid`, see [`super::field`]) at reset and every k actions.
 //! Log times are simulated time: the file's global step count times the control interval.
 
 use std::collections::BTreeMap;
@@ -28,8 +30,10 @@ const INFO_SCHEMA: &str = r#"{"type":"object","properties":{"episode":{"type":"i
 
 pub struct TrajectoryWriter {
     writer: Option<Writer<BufWriter<File>>>,
-    channels: [u16; 4],
+    channels: [u16; 5],
     interval_ns: f64,
+    fields_every: u64,
+    t: f64,
     global_step: u64,
     episode: u64,
     step: u64,
@@ -46,17 +50,21 @@ impl TrajectoryWriter {
             .library(format!("hgym {}", env!("CARGO_PKG_VERSION")))
             .create(BufWriter::new(file))
             .map_err(err)?;
-        let mut channels = [0u16; 4];
+        let mut channels = [0u16; 5];
         for (k, (topic, schema)) in [
             ("/obs", OBS_SCHEMA),
             ("/action", ACTION_SCHEMA),
             ("/reward", REWARD_SCHEMA),
             ("/info", INFO_SCHEMA),
+            ("/field", super::field::SCHEMA),
         ]
         .into_iter()
         .enumerate()
         {
-            let name = format!("hgym{}", topic.replace('/', "."));
+            let name = match topic {
+                "/field" => "foxglove.Grid".to_string(),
+                _ => format!("hgym{}", topic.replace('/', ".")),
+            };
             let sid = w.add_schema(&name, "jsonschema", schema.as_bytes()).map_err(err)?;
             channels[k] = w.add_channel(sid, topic, "json", &BTreeMap::new()).map_err(err)?;
         }
@@ -69,6 +77,8 @@ impl TrajectoryWriter {
             writer: Some(w),
             channels,
             interval_ns: control_interval * 1e9,
+            fields_every: 0,
+            t: 0.0,
             global_step: 0,
             episode: 0,
             step: 0,
@@ -76,10 +86,32 @@ impl TrajectoryWriter {
         })
     }
 
+    /// Flow-field snapshots at each reset and every `every` actions (0: none).
+    pub fn with_fields(mut self, every: u64) -> Self {
+        self.fields_every = every;
+        self
+    }
+
+    /// Whether the caller should pass a snapshot of the current state to [`Self::field`].
+    pub fn wants_field(&self) -> bool {
+        self.fields_every > 0 && self.step.is_multiple_of(self.fields_every)
+    }
+
+    /// Writes a flow-field snapshot of the current step.
+    pub fn field(&mut self, mut s: super::field::Snapshot) -> Result<(), String> {
+        (s.episode, s.step, s.t) = (self.episode, self.step, self.t);
+        let data = s.encode()?;
+        self.put_bytes(4, &data)
+    }
+
     fn put(&mut self, channel: usize, value: serde_json::Value) -> Result<(), String> {
+        let data = serde_json::to_vec(&value).map_err(err)?;
+        self.put_bytes(channel, &data)
+    }
+
+    fn put_bytes(&mut self, channel: usize, data: &[u8]) -> Result<(), String> {
         let log_time = (self.global_step as f64 * self.interval_ns) as u64;
         self.sequence += 1;
-        let data = serde_json::to_vec(&value).map_err(err)?;
         let w = self.writer.as_mut().ok_or("MCAP: writer already finished")?;
         w.write_to_known_channel(
             &MessageHeader {
@@ -88,7 +120,7 @@ impl TrajectoryWriter {
                 log_time,
                 publish_time: log_time,
             },
-            &data,
+            data,
         )
         .map_err(err)
     }
@@ -100,6 +132,7 @@ impl TrajectoryWriter {
     /// Step 0 of a new episode: the reset's observation and info.
     pub fn reset(&mut self, obs: &[f64], info: &Info) -> Result<(), String> {
         self.step = 0;
+        self.t = info.get("t").unwrap_or(0.0);
         self.put(0, json!({"episode": self.episode, "step": 0, "obs": obs}))?;
         let v = self.info_json(info);
         self.put(3, v)
@@ -108,8 +141,20 @@ impl TrajectoryWriter {
     /// One step: the action taken (normalised; physical values from info `actuation_k`) and
     /// what it returned. Closes the chunk at the episode's end.
     pub fn step(&mut self, action: &[f64], r: &StepResult) -> Result<(), String> {
+        self.step_with_field(action, r, None::<fn() -> super::field::Snapshot>)
+    }
+
+    /// [`Self::step`], plus a flow-field snapshot of the state after the step from `snapshot`
+    /// when one is due (see [`Self::with_fields`]); the last step of an episode always has one.
+    pub fn step_with_field<F: FnOnce() -> super::field::Snapshot>(
+        &mut self,
+        action: &[f64],
+        r: &StepResult,
+        snapshot: Option<F>,
+    ) -> Result<(), String> {
         self.step += 1;
         self.global_step += 1;
+        self.t = r.info.get("t").unwrap_or(f64::NAN);
         let physical: Vec<f64> = (0..action.len())
             .map(|k| r.info.get(&format!("actuation_{k}")).unwrap_or(f64::NAN))
             .collect();
@@ -122,7 +167,13 @@ impl TrajectoryWriter {
         )?;
         let v = self.info_json(&r.info);
         self.put(3, v)?;
-        if r.terminated || r.truncated {
+        let last = r.terminated || r.truncated;
+        if let Some(f) = snapshot {
+            if self.fields_every > 0 && (self.wants_field() || last) {
+                self.field(f())?;
+            }
+        }
+        if last {
             self.end_episode()?;
         }
         Ok(())

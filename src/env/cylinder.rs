@@ -19,6 +19,7 @@ use crate::validate::case::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec
 /// The Reynolds numbers of the family.
 pub const REYNOLDS: [u32; 4] = [100, 200, 1000, 3900];
 
+/// The paper's lift weight `w` of the bluff-body reward at `re` (cylinder and square cylinder).
 fn lift_weight(re: u32) -> f64 {
     match re {
         100 => 0.1,
@@ -36,21 +37,37 @@ fn control_interval(re: u32) -> f64 {
     }
 }
 
-/// Wake probes: 4 stations x 5 heights behind the cylinder.
-fn probes() -> Vec<[f64; 2]> {
+/// Wake probes: 4 stations x 5 heights behind the body.
+pub(super) fn probes() -> Vec<[f64; 2]> {
     probe_grid(&[11.0, 12.0, 13.5, 15.0], &[-1.0, -0.5, 0.0, 0.5, 1.0])
 }
 
 fn base(id: String, family: &str, re: u32, actuation: ActuationSpec, description: String) -> EnvSpec {
+    let body = GeometrySpec::Circle {
+        center: [10.0, 0.0],
+        diameter: 1.0,
+    };
+    bluff_body(id, family, re, body, actuation, description, control_interval(re))
+}
+
+/// The paper's 2D bluff-body set-up, shared by the cylinder and square-cylinder families: one body
+/// of size 1 at (10, 0) in [0, 40] x [-10, 10], uniform inflow, periodic sides, the wake rake,
+/// `-|C_D| - w |C_L|`, 200 actions, Smagorinsky C_s = 0.1 from Re 1000.
+pub(super) fn bluff_body(
+    id: String,
+    family: &str,
+    re: u32,
+    body: GeometrySpec,
+    actuation: ActuationSpec,
+    description: String,
+    control_interval: f64,
+) -> EnvSpec {
     EnvSpec {
         id,
         family: family.into(),
         description,
         reynolds: re as f64,
-        bodies: vec![GeometrySpec::Circle {
-            center: [10.0, 0.0],
-            diameter: 1.0,
-        }],
+        bodies: vec![body],
         domain: DomainSpec {
             x: [0.0, 40.0],
             y: [-10.0, 10.0],
@@ -75,7 +92,7 @@ fn base(id: String, family: &str, re: u32, actuation: ActuationSpec, description
         reward: RewardSpec::DragLift {
             lift_weight: lift_weight(re),
         },
-        control_interval: control_interval(re),
+        control_interval,
         episode_actions: 200,
         spin_up: 60.0,
         normalization: Normalization::default(),

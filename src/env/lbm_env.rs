@@ -92,6 +92,12 @@ impl LbmEnv {
                 let (c, r) = circle(*body)?;
                 (angles_deg.iter().map(|a| Jet::on_circle(c, r, *a, *span_deg)).collect(), vec![])
             }
+            ActuationSpec::Jets { body, jets, .. } => {
+                if *body >= spec.bodies.len() {
+                    return Err(EnvError::Backend(format!("{}: jets on body {body}, which does not exist", spec.id)));
+                }
+                (jets.clone(), vec![])
+            }
             ActuationSpec::Rotation { bodies, .. } => (vec![], bodies.iter().map(|&i| circle(i).map(|c| c.0)).collect::<Result<_, _>>()?),
         };
         let act_dim = spec.act_dim();
@@ -142,6 +148,11 @@ impl LbmEnv {
                         rotation: None,
                     }
                 }
+                ActuationSpec::Jets { body, .. } if *body == b => WallMotion {
+                    jets: &self.jets,
+                    amplitudes: a,
+                    rotation: None,
+                },
                 ActuationSpec::Rotation { bodies, .. } => match bodies.iter().position(|&i| i == b) {
                     Some(k) => WallMotion {
                         jets: &[],
@@ -158,7 +169,7 @@ impl LbmEnv {
 
     fn bound(&self) -> f64 {
         match &self.spec.actuation {
-            ActuationSpec::ZnmfJets { max_velocity, .. } => *max_velocity,
+            ActuationSpec::ZnmfJets { max_velocity, .. } | ActuationSpec::Jets { max_velocity, .. } => *max_velocity,
             ActuationSpec::Rotation { max_omega, .. } => *max_omega,
         }
     }

@@ -1,7 +1,7 @@
 //! Flow environments: where solvers (`hgym-solvers`) meet the `Env` contract (`hgym-agents`).
 //!
 //! - [`spec`]: the serialisable description of an environment (its hash keys caches and results);
-//! - [`registry`]: every ID; [`cylinder`], [`pinball`]: the families' specs;
+//! - [`registry`]: every ID; [`cylinder`], [`pinball`], [`square`]: the families' specs;
 //! - [`lbm_env`]: the `Env` implementation for 2D lattice-Boltzmann families;
 //! - [`actuation`]: jets, rotation, and the temporal smoothing of actions.
 
@@ -9,12 +9,14 @@ pub mod actuation;
 pub mod any;
 pub mod calibrate;
 pub mod cylinder;
+pub mod fields;
 pub mod kolmogorov;
 pub mod lbm_env;
 pub mod pinball;
 pub mod registry;
 pub mod rollout;
 pub mod spec;
+pub mod square;
 
 pub use lbm_env::LbmEnv;
 pub use spec::EnvSpec;

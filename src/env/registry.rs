@@ -4,6 +4,7 @@ use super::calibrate;
 use super::cylinder;
 use super::pinball;
 use super::spec::EnvSpec;
+use super::square;
 
 /// All registered specs, in a fixed order, with their committed observation statistics.
 pub fn all() -> Vec<EnvSpec> {
@@ -16,6 +17,9 @@ pub fn all() -> Vec<EnvSpec> {
     }
     for re in pinball::REYNOLDS {
         v.push(pinball::rotary(re));
+    }
+    for re in square::REYNOLDS {
+        v.push(square::square(re));
     }
     // The table is checked by a test; a broken one only means uncalibrated observations.
     let table = calibrate::parse_table(calibrate::TABLE).unwrap_or_default();

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::spec::EnvSpec;
 use super::LbmEnv;
+use crate::env::fields::FlowFields;
 use crate::report::manifest::{manifest, Manifest};
 use crate::report::plots;
 use crate::validate::case::Level;
@@ -34,6 +35,8 @@ pub struct RolloutOptions {
     pub policy: Policy,
     pub out: PathBuf,
     pub cache: Option<PathBuf>,
+    /// Flow-field snapshots in the trajectory at reset and every this many actions (0: none).
+    pub fields_every: u64,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -94,13 +97,17 @@ pub fn rollout(
     std::fs::create_dir_all(&opts.out).map_err(|e| EnvError::Backend(format!("cannot create {}: {e}", opts.out.display())))?;
     let any = crate::env::any::AnySpec::Lbm(spec.clone());
     let policy_name = format!("{:?}", opts.policy).to_lowercase();
-    let mut trajectory = crate::data::trajectory::TrajectoryWriter::create(
+    let trajectory = crate::data::trajectory::TrajectoryWriter::create(
         &opts.out.join("trajectory.mcap"),
         spec.control_interval,
         any.trajectory_manifest(opts.level, &policy_name, &[opts.seed]),
     )
     .map_err(EnvError::Backend)?;
+    let mut trajectory = trajectory.with_fields(opts.fields_every);
     trajectory.reset(&obs0, &info0).map_err(EnvError::Backend)?;
+    if trajectory.wants_field() {
+        trajectory.field(env.snapshot()).map_err(EnvError::Backend)?;
+    }
     let dim = spec.act_dim();
     let mut rng = Rng(opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
     let mut m = Metrics {
@@ -118,7 +125,9 @@ pub fn rollout(
             Policy::Sine => vec![(2.0 * std::f64::consts::PI * k as f64 / 20.0).sin(); dim],
         };
         let r = env.step(&a)?;
-        trajectory.step(&a, &r).map_err(EnvError::Backend)?;
+        trajectory
+            .step_with_field(&a, &r, Some(|| env.snapshot()))
+            .map_err(EnvError::Backend)?;
         m.t.push(r.info.get("t").unwrap_or(0.0));
         m.reward.push(r.reward);
         m.c_d.push(r.info.get("C_D").unwrap_or(f64::NAN));

@@ -9,7 +9,7 @@ use sha2::{Digest, Sha256};
 
 use hgym_solvers::lbm::Collision;
 
-use super::actuation::Ramp;
+use super::actuation::{Jet, Ramp};
 use crate::validate::case::{BoundarySpec, DomainSpec, GeometrySpec, Level, ResolutionSpec};
 
 /// The actuators of an environment; actions in `[-1, 1]` are scaled by the bound given here.
@@ -25,6 +25,10 @@ pub enum ActuationSpec {
         span_deg: f64,
         max_velocity: f64,
     },
+    /// Independent jets on one body (any shape), one action each: jet `k` blows with
+    /// `a_k * max_velocity` (negative: suction). Net mass flux is not zero.
+    /// Bound: `max_velocity` in units of U (peak of the parabolic jet profile).
+    Jets { body: usize, jets: Vec<Jet>, max_velocity: f64 },
     /// Surface rotation of the listed circular bodies, one action each.
     /// Bound: `max_omega` in units of U/D.
     Rotation { bodies: Vec<usize>, max_omega: f64 },
@@ -34,6 +38,7 @@ impl ActuationSpec {
     pub fn dim(&self) -> usize {
         match self {
             ActuationSpec::ZnmfJets { .. } => 1,
+            ActuationSpec::Jets { jets, .. } => jets.len(),
             ActuationSpec::Rotation { bodies, .. } => bodies.len(),
         }
     }

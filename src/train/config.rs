@@ -26,6 +26,9 @@ pub struct TrainSettings {
     /// Write a checkpoint when this many seconds have passed since the last one (and at the end
     /// and on Ctrl-C).
     pub checkpoint_seconds: f64,
+    /// Flow-field snapshots (u, v, vorticity) in the final evaluation's trajectory.mcap at each
+    /// reset and every this many actions (0: none).
+    pub fields_every: u64,
 }
 
 impl Default for TrainSettings {
@@ -37,6 +40,7 @@ impl Default for TrainSettings {
             final_eval_episodes: 3,
             eval_seed: 1_000_000,
             checkpoint_seconds: 60.0,
+            fields_every: 0,
         }
     }
 }

@@ -101,7 +101,7 @@ pub fn uncontrolled_c_d<E: Env + ?Sized>(env: &mut E, seeds: &[u64]) -> Result<V
 
 /// Runs `policy` for one episode per seed; `reference` is the uncontrolled C_D per seed.
 #[allow(clippy::too_many_arguments)]
-pub fn evaluate<E: Env + ?Sized>(
+pub fn evaluate<E: Env + crate::env::fields::FlowFields + ?Sized>(
     env: &mut E,
     policy: &mut dyn Policy,
     policy_name: &str,
@@ -120,6 +120,9 @@ pub fn evaluate<E: Env + ?Sized>(
         let (mut obs, mut info) = env.reset(*seed)?;
         if let Some(t) = trajectory.as_deref_mut() {
             t.reset(&obs, &info).map_err(io)?;
+            if t.wants_field() {
+                t.field(env.snapshot()).map_err(io)?;
+            }
         }
         policy.reset();
         let mut action = vec![0.0; env.action_space().dim()];
@@ -129,7 +132,7 @@ pub fn evaluate<E: Env + ?Sized>(
             let r = env.step(&action)?;
             cost += action.iter().map(|v| v * v).sum::<f64>();
             if let Some(t) = trajectory.as_deref_mut() {
-                t.step(&action, &r).map_err(io)?;
+                t.step_with_field(&action, &r, Some(|| env.snapshot())).map_err(io)?;
             }
             acc.add(&r);
             let done = r.terminated || r.truncated;

@@ -236,7 +236,8 @@ pub fn train(
         spec.control_interval(),
         spec.trajectory_manifest(opts.level, opts.algo.name(), &final_seeds),
     )
-    .map_err(TrainError::Io)?;
+    .map_err(TrainError::Io)?
+    .with_fields(config.train.fields_every);
     let report = evaluate(
         &mut eval_env,
         &mut policy,

@@ -24,9 +24,15 @@ pub const BUNDLED: &[(&str, &str)] = &[
         "cylinder_re200.toml",
         include_str!("../../benchmarks/validation/cylinder_re200.toml"),
     ),
+    (
+        "cylinder_re1000.toml",
+        include_str!("../../benchmarks/validation/cylinder_re1000.toml"),
+    ),
     ("pinball_re30.toml", include_str!("../../benchmarks/validation/pinball_re30.toml")),
     ("pinball_re100.toml", include_str!("../../benchmarks/validation/pinball_re100.toml")),
     ("pinball_re150.toml", include_str!("../../benchmarks/validation/pinball_re150.toml")),
+    ("square_re200.toml", include_str!("../../benchmarks/validation/square_re200.toml")),
+    ("square_re1000.toml", include_str!("../../benchmarks/validation/square_re1000.toml")),
 ];
 
 /// Largest lattice speed anywhere on the inlet (Mach 0.3 = 0.173 lattice units): above it the

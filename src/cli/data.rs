@@ -1,0 +1,135 @@
+//! `hgym export` and `hgym push`: trajectory files to a Hugging Face dataset folder, and that
+//! folder to the Hub.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::{Args, ValueEnum};
+use hgym::data::hf::{export, ExportOptions};
+use hgym::data::hub::{self, HubConfig, HubError};
+
+use crate::{Outcome, UsageError};
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum ExportFormat {
+    /// Hugging Face dataset folder: Parquet shards + README.md dataset card.
+    Hf,
+}
+
+#[derive(Args)]
+pub struct ExportArgs {
+    /// Target format.
+    #[arg(long = "to", value_enum, default_value = "hf")]
+    to: ExportFormat,
+    /// A folder searched recursively for *.mcap trajectories (e.g. results/train), or one file.
+    dir: PathBuf,
+    /// The dataset folder to write (new, empty, or an earlier export, whose data it replaces).
+    out: PathBuf,
+    /// Rows per Parquet shard of the step tables.
+    #[arg(long, default_value_t = 100_000)]
+    shard_rows: usize,
+    /// Licence in the dataset card (SPDX ID as the Hub lists them).
+    #[arg(long, default_value = "cc-by-4.0")]
+    license: String,
+    /// Dataset title in the card.
+    #[arg(long)]
+    name: Option<String>,
+    /// Print what was written as JSON (the content of OUT/hgym_export.json).
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run_export(args: ExportArgs) -> Result<Outcome> {
+    let ExportFormat::Hf = args.to;
+    if args.shard_rows == 0 {
+        return Err(UsageError("--shard-rows must be at least 1".into()).into());
+    }
+    let opts = ExportOptions {
+        shard_rows: args.shard_rows,
+        license: args.license.clone(),
+        pretty_name: args.name.clone(),
+        ..ExportOptions::default()
+    };
+    let paths = hgym::data::hf::find_trajectories(&args.dir).map_err(UsageError)?;
+    let pb = crate::progress_bar(paths.len() as u64, "reading");
+    let report = export(&args.dir, &args.out, &opts, &mut |k, _| pb.set_position(k as u64)).map_err(UsageError)?;
+    pb.finish_and_clear();
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!(
+            "exported {} control steps{} from {} trajectory files into {}",
+            report.rows,
+            if report.snapshots > 0 {
+                format!(" and {} flow-field snapshots", report.snapshots)
+            } else {
+                String::new()
+            },
+            report.runs.len(),
+            args.out.display()
+        );
+        println!("  configs: {}", report.configs.join(", "));
+        println!("  files:   {}", report.files.len() + 2);
+        println!(
+            "  check it: python -c \"import pandas; print(pandas.read_parquet('{}/data/{}'))\"",
+            args.out.display(),
+            report.configs.first().map(|s| s.as_str()).unwrap_or("ENV")
+        );
+        println!("  upload:  hgym push {} --repo USER/NAME", args.out.display());
+    }
+    Ok(Outcome::Ok)
+}
+
+#[derive(Args)]
+pub struct PushArgs {
+    /// The dataset folder (`hgym export --to hf DIR OUT` writes one).
+    dir: PathBuf,
+    /// Dataset repository on the Hub, user/name or org/name; created if it does not exist.
+    #[arg(long)]
+    repo: String,
+    /// Create the repository private (an existing repository keeps its visibility).
+    #[arg(long)]
+    private: bool,
+    /// Commit message.
+    #[arg(long, default_value = "Upload hgym dataset")]
+    message: String,
+    /// Retries per request on 429, 5xx and network failures (exponential backoff from 0.5 s).
+    #[arg(long, default_value_t = 5)]
+    retries: u32,
+    /// Print the result as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Token, repository and folder problems are the user's to fix (exit 2); the server's are not.
+fn classify(e: HubError) -> anyhow::Error {
+    match e {
+        HubError::NoToken | HubError::BadRepo(_) | HubError::Auth { .. } | HubError::Io(_) => UsageError(e.to_string()).into(),
+        other => other.into(),
+    }
+}
+
+pub fn run_push(args: PushArgs) -> Result<Outcome> {
+    hub::check_repo(&args.repo).map_err(classify)?;
+    let cfg = HubConfig::from_env(args.retries).map_err(classify)?;
+    let json = args.json;
+    let report = hub::push(&args.dir, &args.repo, args.private, &args.message, &cfg, &mut |m| {
+        if !json {
+            eprintln!("{m}");
+        }
+    })
+    .map_err(classify)?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!(
+            "pushed {} files ({} bytes, {} through LFS) to {}{}",
+            report.files,
+            report.bytes,
+            report.lfs_files,
+            report.url,
+            if report.created { " (new repository)" } else { "" }
+        );
+    }
+    Ok(Outcome::Ok)
+}

@@ -1,0 +1,168 @@
+//! Flow-field snapshots in trajectory files: the `/field` channel, one message every k actions,
+//! encoded as Foxglove's `foxglove.Grid` (JSON encoding, the cell data base64 little-endian
+//! float32, fields interleaved per cell) so that Foxglove's 3D panel shows it as a coloured grid
+//! and Python reads it with `numpy.frombuffer(base64.b64decode(m["data"]), "<f4")`. The chunk is
+//! zstd-compressed like every other channel. hgym adds `episode`, `step`, `t` and `extent`
+//! (x0, x1, y0, y1 in the env's units) to the Grid's fields.
+
+use base64::Engine;
+use serde_json::{json, Value};
+
+/// `foxglove.NumericType.FLOAT32`.
+const FLOAT32: u64 = 7;
+
+/// JSON Schema of the message: foxglove.Grid plus hgym's episode, step, t and extent.
+pub const SCHEMA: &str = r#"{"title":"foxglove.Grid","type":"object","properties":{
+"timestamp":{"type":"object","properties":{"sec":{"type":"integer"},"nsec":{"type":"integer"}}},
+"frame_id":{"type":"string"},
+"pose":{"type":"object","properties":{"position":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}},"orientation":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"},"w":{"type":"number"}}}}},
+"column_count":{"type":"integer"},
+"cell_size":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"}}},
+"row_stride":{"type":"integer"},"cell_stride":{"type":"integer"},
+"fields":{"type":"array","items":{"type":"object","properties":{"name":{"type":"string"},"offset":{"type":"integer"},"type":{"type":"integer"}}}},
+"data":{"type":"string","contentEncoding":"base64"},
+"episode":{"type":"integer"},"step":{"type":"integer"},"t":{"type":"number"},
+"extent":{"type":"array","items":{"type":"number"},"minItems":4,"maxItems":4}},
+"required":["column_count","cell_stride","row_stride","fields","data","episode","step"]}"#;
+
+/// Named scalar fields on one `nx x ny` grid, row-major `f[y * nx + x]`, `y` upwards.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    pub episode: u64,
+    pub step: u64,
+    pub t: f64,
+    pub nx: usize,
+    pub ny: usize,
+    /// `[x0, x1, y0, y1]` of the grid in the env's units.
+    pub extent: [f64; 4],
+    pub fields: Vec<(String, Vec<f32>)>,
+}
+
+impl Snapshot {
+    /// The `foxglove.Grid` JSON message.
+    pub fn encode(&self) -> Result<Vec<u8>, String> {
+        let cells = self.nx * self.ny;
+        if let Some((name, f)) = self.fields.iter().find(|(_, f)| f.len() != cells) {
+            return Err(format!("field {name} has {} values, the grid {cells}", f.len()));
+        }
+        let k = self.fields.len();
+        let mut data = Vec::with_capacity(cells * k * 4);
+        for c in 0..cells {
+            for (_, f) in &self.fields {
+                data.extend_from_slice(&f[c].to_le_bytes());
+            }
+        }
+        let [x0, x1, y0, y1] = self.extent;
+        let v = json!({
+            "timestamp": {"sec": self.t.max(0.0).floor() as u64, "nsec": (self.t.max(0.0).fract() * 1e9) as u64},
+            "frame_id": "flow",
+            "pose": {"position": {"x": x0, "y": y0, "z": 0.0}, "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}},
+            "column_count": self.nx,
+            "cell_size": {"x": (x1 - x0) / self.nx as f64, "y": (y1 - y0) / self.ny as f64},
+            "row_stride": self.nx * k * 4,
+            "cell_stride": k * 4,
+            "fields": self.fields.iter().enumerate()
+                .map(|(j, (name, _))| json!({"name": name, "offset": 4 * j, "type": FLOAT32}))
+                .collect::<Vec<_>>(),
+            "data": base64::engine::general_purpose::STANDARD.encode(&data),
+            "episode": self.episode,
+            "step": self.step,
+            "t": self.t,
+            "extent": self.extent,
+        });
+        serde_json::to_vec(&v).map_err(|e| e.to_string())
+    }
+
+    /// The inverse of [`Snapshot::encode`].
+    pub fn decode(bytes: &[u8]) -> Result<Snapshot, String> {
+        let v: Value = serde_json::from_slice(bytes).map_err(|e| format!("field message: {e}"))?;
+        let int = |k: &str| v[k].as_u64().ok_or_else(|| format!("field message without {k}"));
+        let nx = int("column_count")? as usize;
+        let stride = int("cell_stride")? as usize;
+        let data = base64::engine::general_purpose::STANDARD
+            .decode(v["data"].as_str().unwrap_or(""))
+            .map_err(|e| format!("field data: {e}"))?;
+        if nx == 0 || stride == 0 || data.len() % (nx * stride) != 0 {
+            return Err("field message: data does not fill whole rows".into());
+        }
+        let ny = data.len() / (nx * stride);
+        let names: Vec<(String, usize)> = v["fields"]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .map(|f| {
+                        (
+                            f["name"].as_str().unwrap_or("").to_string(),
+                            f["offset"].as_u64().unwrap_or(0) as usize,
+                        )
+                    })
+                    .collect()
+            })
+            .unwrap_or_default();
+        let fields = names
+            .into_iter()
+            .map(|(name, off)| {
+                let vals = (0..nx * ny)
+                    .map(|c| {
+                        let b = &data[c * stride + off..c * stride + off + 4];
+                        f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+                    })
+                    .collect();
+                (name, vals)
+            })
+            .collect();
+        let e = v["extent"].as_array().cloned().unwrap_or_default();
+        let ext = |k: usize| e.get(k).and_then(|x| x.as_f64()).unwrap_or(f64::NAN);
+        Ok(Snapshot {
+            episode: int("episode")?,
+            step: int("step")?,
+            t: v["t"].as_f64().unwrap_or(f64::NAN),
+            nx,
+            ny,
+            extent: [ext(0), ext(1), ext(2), ext(3)],
+            fields,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_round_trip() {
+        let s = Snapshot {
+            episode: 2,
+            step: 30,
+            t: 12.5,
+            nx: 3,
+            ny: 2,
+            extent: [0.0, 3.0, -1.0, 1.0],
+            fields: vec![
+                ("u".into(), vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]),
+                ("vorticity".into(), vec![f32::NAN, -1.0, 0.5, 0.25, 1e-8, 7.0]),
+            ],
+        };
+        let back = Snapshot::decode(&s.encode().unwrap()).unwrap();
+        assert_eq!(back.nx, 3);
+        assert_eq!(back.ny, 2);
+        assert_eq!(back.fields[0], s.fields[0]);
+        assert!(back.fields[1].1[0].is_nan());
+        assert_eq!(back.fields[1].1[1..], s.fields[1].1[1..]);
+        assert_eq!(back.extent, s.extent);
+    }
+
+    #[test]
+    fn wrong_field_length_is_refused() {
+        let s = Snapshot {
+            episode: 0,
+            step: 0,
+            t: 0.0,
+            nx: 2,
+            ny: 2,
+            extent: [0.0; 4],
+            fields: vec![("u".into(), vec![0.0; 3])],
+        };
+        assert!(s.encode().unwrap_err().contains("has 3 values"));
+    }
+}

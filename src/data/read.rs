@@ -1,0 +1,120 @@
+//! Reading `trajectory.mcap` files back into control steps: the inverse of
+//! [`super::trajectory::TrajectoryWriter`]. One [`StepRow`] per (episode, step), joining the
+//! `/obs`, `/action`, `/reward` and `/info` messages of that step; the `manifest` metadata
+//! record; the flow-field snapshots of `/field` (see [`super::field`]).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use mcap::read::MessageStream;
+use serde_json::Value;
+
+/// One control step of one episode. Step 0 is the reset: it has an observation and info but no
+/// action or reward.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepRow {
+    pub episode: u64,
+    pub step: u64,
+    pub obs: Vec<f64>,
+    pub action: Option<Vec<f64>>,
+    pub action_physical: Option<Vec<f64>>,
+    pub reward: Option<f64>,
+    pub terminated: bool,
+    pub truncated: bool,
+    /// Numeric info values (`t`, `C_D`, `C_L`, ...); `None` where the writer stored null (NaN).
+    pub info: BTreeMap<String, Option<f64>>,
+}
+
+/// Everything one trajectory file holds.
+#[derive(Clone, Debug, Default)]
+pub struct Trajectory {
+    pub manifest: BTreeMap<String, String>,
+    pub rows: Vec<StepRow>,
+    pub fields: Vec<super::field::Snapshot>,
+}
+
+impl Trajectory {
+    pub fn env_id(&self) -> &str {
+        self.manifest.get("env_id").map(|s| s.as_str()).unwrap_or("unknown")
+    }
+
+    /// The seed of episode `e`, when the manifest lists one seed per episode.
+    pub fn seed_of(&self, e: u64) -> Option<u64> {
+        let seeds = self.manifest.get("seeds")?;
+        let seeds: Vec<u64> = serde_json::from_str(seeds).ok()?;
+        seeds.get(e as usize).copied()
+    }
+
+    pub fn episodes(&self) -> usize {
+        self.rows.iter().map(|r| r.episode + 1).max().unwrap_or(0) as usize
+    }
+}
+
+fn numbers(v: &Value) -> Vec<f64> {
+    v.as_array()
+        .map(|a| a.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect())
+        .unwrap_or_default()
+}
+
+/// Reads a complete (or `hgym data recover`-ed) trajectory file.
+pub fn read(path: &Path) -> Result<Trajectory, String> {
+    let buf = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let bad = |e: &dyn std::fmt::Display| {
+        format!(
+            "{} is not a readable MCAP file ({e}); if a run was killed, `hgym data recover {}` salvages it",
+            path.display(),
+            path.display()
+        )
+    };
+    let mut manifest = BTreeMap::new();
+    let summary = mcap::Summary::read(&buf).map_err(|e| bad(&e))?;
+    if let Some(summary) = summary {
+        for index in &summary.metadata_indexes {
+            if index.name == "manifest" {
+                let m = mcap::read::metadata(&buf, index).map_err(|e| bad(&e))?;
+                manifest = m.metadata;
+            }
+        }
+    } else {
+        return Err(bad(&"no summary section: the file was not finished"));
+    }
+    let mut rows: BTreeMap<(u64, u64), StepRow> = BTreeMap::new();
+    let mut fields = vec![];
+    for m in MessageStream::new(&buf).map_err(|e| bad(&e))? {
+        let m = m.map_err(|e| bad(&e))?;
+        if m.channel.topic == "/field" {
+            fields.push(super::field::Snapshot::decode(&m.data).map_err(|e| bad(&e))?);
+            continue;
+        }
+        let v: Value = serde_json::from_slice(&m.data).map_err(|e| bad(&e))?;
+        let key = (v["episode"].as_u64().unwrap_or(0), v["step"].as_u64().unwrap_or(0));
+        let row = rows.entry(key).or_insert_with(|| StepRow {
+            episode: key.0,
+            step: key.1,
+            ..StepRow::default()
+        });
+        match m.channel.topic.as_str() {
+            "/obs" => row.obs = numbers(&v["obs"]),
+            "/action" => {
+                row.action = Some(numbers(&v["normalised"]));
+                row.action_physical = Some(numbers(&v["physical"]));
+            }
+            "/reward" => {
+                row.reward = v["reward"].as_f64();
+                row.terminated = v["terminated"].as_bool().unwrap_or(false);
+                row.truncated = v["truncated"].as_bool().unwrap_or(false);
+            }
+            "/info" => {
+                if let Some(values) = v["values"].as_object() {
+                    row.info = values.iter().map(|(k, x)| (k.clone(), x.as_f64())).collect();
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(Trajectory {
+        manifest,
+        rows: rows.into_values().collect(),
+        fields,
+    })
+}
