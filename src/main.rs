@@ -490,8 +490,11 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
                 hgym::env::any::AnySpec::Lbm(s) => !s.normalization.mean.is_empty(),
                 hgym::env::any::AnySpec::Kolmogorov(s) => s.statistics.u_rms > 0.0,
             };
+            // The committed validation results (results/validation/) of the flow behind each ID.
             let validation = |s: &hgym::env::any::AnySpec| match s.family() {
-                "cylinder" | "rotary_cylinder" if s.reynolds() <= 200.0 => "cylinder (pass)",
+                "cylinder" | "rotary_cylinder" if s.reynolds() <= 1000.0 => "cylinder (pass)",
+                "pinball" | "jet_pinball" if s.reynolds() != 75.0 => "pinball (fail)",
+                "square_cylinder" if s.reynolds() <= 1000.0 => "square (fail)",
                 "kolmogorov" if s.reynolds() <= 40.0 => "kolmogorov (bursts)",
                 _ => "-",
             };
@@ -510,12 +513,12 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
                 println!("{}", serde_json::to_string_pretty(&rows)?);
             } else {
                 println!(
-                    "{:<26} {:>3} {:>7} {:>5} {:>5} {:<10} {:<10} validation",
+                    "{:<30} {:>3} {:>7} {:>5} {:>5} {:<10} {:<10} validation",
                     "ID", "dim", "Re", "obs", "act", "solver", "calibrated"
                 );
                 for s in &specs {
                     println!(
-                        "{:<26} {:>3} {:>7} {:>5} {:>5} {:<10} {:<10} {}",
+                        "{:<30} {:>3} {:>7} {:>5} {:>5} {:<10} {:<10} {}",
                         s.id(),
                         "2D",
                         s.reynolds(),
@@ -594,6 +597,9 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
                 })
                 .with_context(|| format!("calibrating {id}"))?;
             pb.finish_and_clear();
+            if let Some([c_d, c_l]) = entry.mean_forces {
+                println!("{id}: uncontrolled mean C_D {c_d:.4}, mean C_L {c_l:.4}");
+            }
             entries.insert(id.clone(), entry);
             let header: String = text.lines().take_while(|l| l.starts_with('#')).map(|l| format!("{l}\n")).collect();
             let body = toml::to_string_pretty(&entries).context("cannot format the table")?;

@@ -21,12 +21,19 @@ pub struct Entry {
     pub actions: usize,
     pub mean: Vec<f64>,
     pub scale: Vec<f64>,
+    /// Mean total (C_D, C_L) of the uncontrolled run: the reference of force-deviation rewards
+    /// (the gust environments take theirs from the undisturbed flow's entry).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mean_forces: Option<[f64; 2]>,
 }
 
 /// Hash of the spec with its normalisation removed (what the statistics depend on).
 pub fn physics_hash(spec: &EnvSpec) -> String {
     let mut s = spec.clone();
     s.normalization = Normalization::default();
+    // The uncontrolled statistics do not depend on the reward or the episode length.
+    s.reward = super::spec::RewardSpec::DragLift { lift_weight: 0.0 };
+    s.episode_actions = 0;
     s.hash()
 }
 
@@ -64,8 +71,11 @@ pub fn calibrate(
     let dim = spec.obs_dim();
     let (mut sum, mut sq) = (vec![0.0f64; dim], vec![0.0f64; dim]);
     let zero = vec![0.0; spec.act_dim()];
+    let mut forces = [0.0f64; 2];
     for k in 0..actions {
         let r = env.step(&zero)?;
+        forces[0] += r.info.get("C_D").unwrap_or(0.0);
+        forces[1] += r.info.get("C_L").unwrap_or(0.0);
         if r.terminated {
             return Err(EnvError::Backend(format!(
                 "{}: uncontrolled run diverged: {}",
@@ -93,5 +103,6 @@ pub fn calibrate(
         actions,
         mean,
         scale,
+        mean_forces: Some([forces[0] / n, forces[1] / n]),
     })
 }

@@ -96,6 +96,7 @@ pub(super) fn bluff_body(
         episode_actions: 200,
         spin_up: 60.0,
         normalization: Normalization::default(),
+        gust: None,
     }
 }
 

@@ -16,7 +16,7 @@
 use std::path::PathBuf;
 
 use hgym_agents::{checked_action, BoxSpace, Env, EnvError, Info, StepResult};
-use hgym_solvers::lbm::{D2q9, D2q9Config, Grid, Units};
+use hgym_solvers::lbm::{D2q9, D2q9Config, Edge, Grid, Units};
 
 use super::actuation::{apply, Jet, WallMotion};
 use super::spec::{ActuationSpec, EnvSpec, RewardSpec};
@@ -92,6 +92,19 @@ impl LbmEnv {
                 let (c, r) = circle(*body)?;
                 (angles_deg.iter().map(|a| Jet::on_circle(c, r, *a, *span_deg)).collect(), vec![])
             }
+            ActuationSpec::ZnmfJetsPerBody {
+                bodies,
+                angles_deg,
+                span_deg,
+                ..
+            } => {
+                let mut jets = vec![];
+                for &b in bodies {
+                    let (c, r) = circle(b)?;
+                    jets.extend(angles_deg.iter().map(|a| Jet::on_circle(c, r, *a, *span_deg)));
+                }
+                (jets, vec![])
+            }
             ActuationSpec::Jets { body, jets, .. } => {
                 if *body >= spec.bodies.len() {
                     return Err(EnvError::Backend(format!("{}: jets on body {body}, which does not exist", spec.id)));
@@ -138,6 +151,7 @@ impl LbmEnv {
     /// Sets the wall velocities for physical actuation `a` (units of U or U/D).
     fn actuate(&mut self, a: &[f64]) {
         let n_bodies = self.spec.bodies.len();
+        let mut pair: [f64; 2];
         for b in 0..n_bodies {
             let motion = match &self.spec.actuation {
                 ActuationSpec::ZnmfJets { body, .. } if *body == b => {
@@ -148,6 +162,18 @@ impl LbmEnv {
                         rotation: None,
                     }
                 }
+                ActuationSpec::ZnmfJetsPerBody { bodies, .. } => match bodies.iter().position(|&i| i == b) {
+                    // Jets 2k and 2k + 1 belong to the k-th listed body: blowing and suction.
+                    Some(k) => {
+                        pair = [a[k], -a[k]];
+                        WallMotion {
+                            jets: &self.jets[2 * k..2 * k + 2],
+                            amplitudes: &pair,
+                            rotation: None,
+                        }
+                    }
+                    None => WallMotion::default(),
+                },
                 ActuationSpec::Jets { body, .. } if *body == b => WallMotion {
                     jets: &self.jets,
                     amplitudes: a,
@@ -169,23 +195,38 @@ impl LbmEnv {
 
     fn bound(&self) -> f64 {
         match &self.spec.actuation {
-            ActuationSpec::ZnmfJets { max_velocity, .. } | ActuationSpec::Jets { max_velocity, .. } => *max_velocity,
+            ActuationSpec::ZnmfJets { max_velocity, .. }
+            | ActuationSpec::ZnmfJetsPerBody { max_velocity, .. }
+            | ActuationSpec::Jets { max_velocity, .. } => *max_velocity,
             ActuationSpec::Rotation { max_omega, .. } => *max_omega,
         }
     }
 
-    /// The cache key covers what shapes the developed flow, not the episode length, the
-    /// observation statistics or the reward: calibration, rollouts and training share one state.
+    /// The cache key covers only what shapes the developed (uncontrolled) flow: geometry, domain,
+    /// boundaries, resolution, Re, lattice and collision settings, spin-up. Not the ID, the
+    /// actuators (the attractor is reached with them at rest, so a jet and a rotary variant of one
+    /// flow share it), probes, reward, timing, episode length, normalisation or gust: calibration,
+    /// rollouts, training and every variant of a flow share one state per level.
     fn cache_file(&self) -> Option<PathBuf> {
         let mut physics = self.spec.clone();
+        physics.id.clear();
+        physics.family.clear();
+        physics.description.clear();
+        physics.actuation = ActuationSpec::Rotation {
+            bodies: vec![],
+            max_omega: 0.0,
+        };
         physics.normalization = Default::default();
         physics.episode_actions = 0;
+        physics.control_interval = 0.0;
         physics.probes.clear();
         physics.reward = RewardSpec::DragLift { lift_weight: 0.0 };
+        physics.gust = None;
+        physics.ramp = Default::default();
         let hash = physics.hash();
         self.cache_dir
             .as_ref()
-            .map(|d| d.join(format!("{}-{}-{}.f32", self.spec.id, self.level.name(), &hash[..16])))
+            .map(|d| d.join(format!("flow-{}-{}.f32", self.level.name(), &hash[..16])))
     }
 
     /// The developed flow: from memory, from the disk cache, or by spinning up.
@@ -237,6 +278,23 @@ impl LbmEnv {
         Ok(state)
     }
 
+    /// Mass (lattice units per step) that each actuator alone injects at its full positive bound,
+    /// summed over the bodies: nonzero for a jet that reaches wall links, zero for a rotation or a
+    /// zero-net-mass-flux pair. Leaves the actuators at rest. For tests and diagnostics.
+    pub fn actuator_mass_sources(&mut self) -> Vec<f64> {
+        let dim = self.spec.act_dim();
+        let bound = self.bound();
+        let mut out = Vec::with_capacity(dim);
+        for k in 0..dim {
+            let mut a = vec![0.0; dim];
+            a[k] = bound;
+            self.actuate(&a);
+            out.push((0..self.spec.bodies.len()).map(|b| self.solver.wall_mass_source(b)).sum());
+        }
+        self.actuate(&vec![0.0; dim]);
+        out
+    }
+
     /// Raw probe values (u, v, p per probe; units of U and rho U^2).
     pub fn raw_observation(&self) -> Result<Vec<f64>, EnvError> {
         let mut obs = Vec::with_capacity(self.spec.obs_dim());
@@ -258,6 +316,17 @@ impl LbmEnv {
             }
         }
         Ok(obs)
+    }
+
+    /// With a gust, sets the (west) inflow for episode time `t` to `(U, v_gust(t))`; without one,
+    /// the inflow stays as built.
+    fn set_gust(&mut self, t: f64) -> Result<(), EnvError> {
+        let Some(g) = &self.spec.gust else {
+            return Ok(());
+        };
+        let v = g.velocity(t);
+        let u = self.spec.lattice_velocity;
+        self.solver.set_side_velocity(Edge::West, [u, u * v]).map_err(backend)
     }
 
     fn time(&self) -> f64 {
@@ -286,6 +355,7 @@ impl Env for LbmEnv {
         self.a_old = vec![0.0; self.spec.act_dim()];
         let zero = self.a_old.clone();
         self.actuate(&zero);
+        self.set_gust(0.0)?;
         let offset = (splitmix64(seed) % 64) * (self.steps_per_action / 2).max(1);
         self.solver.advance(offset).map_err(backend)?;
         self.t0 = self.solver.time();
@@ -317,6 +387,9 @@ impl Env for LbmEnv {
                 *v = self.spec.ramp.blend(self.a_old[k], a_new[k], tau);
             }
             self.actuate(&now);
+            if self.spec.gust.is_some() {
+                self.set_gust(self.time())?;
+            }
             if let Err(e) = self.solver.step() {
                 diverged = Some(e.to_string());
                 break;
@@ -353,13 +426,14 @@ impl Env for LbmEnv {
                 info,
             });
         }
-        let reward = reward(&self.spec.reward, &info, n_bodies);
+        let obs = self.observation()?;
+        let reward = reward(&self.spec.reward, &info, &obs, n_bodies);
         let truncated = self.actions_taken >= self.spec.episode_actions;
         if truncated {
             self.live = false;
         }
         Ok(StepResult {
-            obs: self.observation()?,
+            obs,
             reward,
             terminated: false,
             truncated,
@@ -368,8 +442,9 @@ impl Env for LbmEnv {
     }
 }
 
-/// The reward from the force coefficients in `info` (so it can be recomputed from `info` alone).
-pub fn reward(spec: &RewardSpec, info: &Info, n_bodies: usize) -> f64 {
+/// The reward from the force coefficients in `info` and the (normalised) observation `obs` at the
+/// end of the interval, so it can be recomputed from what `step` returns.
+pub fn reward(spec: &RewardSpec, info: &Info, obs: &[f64], n_bodies: usize) -> f64 {
     match spec {
         RewardSpec::DragLift { lift_weight } => {
             let mut r = 0.0;
@@ -378,6 +453,24 @@ pub fn reward(spec: &RewardSpec, info: &Info, n_bodies: usize) -> f64 {
                 r -= lift_weight * info.get(&format!("C_L_{b}")).unwrap_or(0.0).abs();
             }
             r
+        }
+        RewardSpec::TotalDragLift { lift_weight } => {
+            let (mut c_d, mut c_l) = (0.0, 0.0);
+            for b in 0..n_bodies {
+                c_d += info.get(&format!("C_D_{b}")).unwrap_or(0.0);
+                c_l += info.get(&format!("C_L_{b}")).unwrap_or(0.0);
+            }
+            -c_d.abs() - lift_weight * c_l.abs()
+        }
+        RewardSpec::ProbeDeviation => -9.0 * obs.iter().map(|o| o * o).sum::<f64>(),
+        RewardSpec::GustLoads {
+            c_l_ref,
+            c_d_ref,
+            drag_weight,
+        } => {
+            let c_d = info.get("C_D").unwrap_or(0.0);
+            let c_l = info.get("C_L").unwrap_or(0.0);
+            -(c_l - c_l_ref).abs() - drag_weight * (c_d - c_d_ref).abs()
         }
     }
 }

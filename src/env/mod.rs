@@ -1,17 +1,20 @@
 //! Flow environments: where solvers (`hgym-solvers`) meet the `Env` contract (`hgym-agents`).
 //!
 //! - [`spec`]: the serialisable description of an environment (its hash keys caches and results);
-//! - [`registry`]: every ID; [`cylinder`], [`pinball`], [`square`]: the families' specs;
+//! - [`registry`]: every ID; [`cylinder`], [`pinball`], [`square`], [`cavity`], [`naca`]: the
+//!   families' specs;
 //! - [`lbm_env`]: the `Env` implementation for 2D lattice-Boltzmann families;
 //! - [`actuation`]: jets, rotation, and the temporal smoothing of actions.
 
 pub mod actuation;
 pub mod any;
 pub mod calibrate;
+pub mod cavity;
 pub mod cylinder;
 pub mod fields;
 pub mod kolmogorov;
 pub mod lbm_env;
+pub mod naca;
 pub mod pinball;
 pub mod registry;
 pub mod rollout;

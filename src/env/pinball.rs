@@ -2,12 +2,14 @@
 //! `Pinball_2D_Re{30,75,100,150}`, three cylinders of diameter D on an equilateral triangle
 //! pointing upstream, centres at (-1.299, 0), (0, 0.75), (0, -0.75) relative to the pinball centre
 //! (10, 0), in the cylinder's domain [0, 40] x [-10, 10]. Actions: surface rotation of the three
-//! cylinders, bound 2.0 U/D each (surface speed U).
+//! cylinders, bound 2.0 U/D each (surface speed U). `JetPinball_2D_Re{...}`: a jet pair on each
+//! cylinder instead (see [`jets`]).
 //!
-//! Reward, as the paper writes it: `r = -sum_i |C_D,i| - w sum_i |C_L,i|`. The paper gives no
-//! value for `w`; we take `w = 0.2` (the cylinder's value at Re 200): large enough that rotating
-//! for Magnus lift does not pay, small enough that the rear cylinders' natural mean lift (up to
-//! 0.36 at Re 30) does not dominate the drag term.
+//! Reward, as the paper's environment appendix writes it: `r = -|sum_i C_D,i| - w |sum_i C_L,i|`
+//! with `w = 1.0` at every Re (to keep policies from generating lift). The rear cylinders'
+//! natural mean lifts (about +-0.36 at Re 30) cancel in the sum, so they do not enter the reward.
+//! (Until this change the spec used `-sum_i |C_D,i| - 0.2 sum_i |C_L,i|`; results trained with
+//! it carry the old spec hash.)
 //!
 //! Control interval: a twentieth of the natural period (200 actions ~ 10 periods), with
 //! f0 = 0.065, 0.08, 0.090, 0.118 (Wang et al. 2023; Re 75 interpolated): 0.77, 0.62, 0.56 and
@@ -46,6 +48,26 @@ pub fn bodies() -> Vec<GeometrySpec> {
         .collect()
 }
 
+/// `JetPinball_2D_Re{re}`: the pinball with a zero-net-mass-flux jet pair at 90 and 270 degrees
+/// on each cylinder (10 degrees wide, peak bound 1.0 U, as the cylinder family's), one action per
+/// cylinder. The paper's standard pinball uses rotation and leaves jets to users; this is that
+/// variant with HydroGym's name. Same flow, reward and timing as `Pinball_2D_Re{re}`, so the two
+/// share the developed-flow state only if their physics hashes agree (they do not: the actuator
+/// is part of the spec), and each is calibrated on its own.
+pub fn jets(re: u32) -> EnvSpec {
+    let mut s = rotary(re);
+    s.id = format!("JetPinball_2D_Re{re}");
+    s.family = "jet_pinball".into();
+    s.description = format!("2D fluidic pinball at Re {re}, a zero-net-mass-flux jet pair on each cylinder");
+    s.actuation = ActuationSpec::ZnmfJetsPerBody {
+        bodies: vec![0, 1, 2],
+        angles_deg: [90.0, 270.0],
+        span_deg: 10.0,
+        max_velocity: 1.0,
+    };
+    s
+}
+
 /// `Pinball_2D_Re{re}`.
 pub fn rotary(re: u32) -> EnvSpec {
     EnvSpec {
@@ -78,10 +100,11 @@ pub fn rotary(re: u32) -> EnvSpec {
         },
         ramp: Ramp::default(),
         probes: probes(),
-        reward: RewardSpec::DragLift { lift_weight: 0.2 },
+        reward: RewardSpec::TotalDragLift { lift_weight: 1.0 },
         control_interval: control_interval(re),
         episode_actions: 200,
         spin_up: 150.0,
         normalization: Normalization::default(),
+        gust: None,
     }
 }

@@ -1,7 +1,9 @@
 //! Every environment ID and its spec.
 
 use super::calibrate;
+use super::cavity;
 use super::cylinder;
+use super::naca;
 use super::pinball;
 use super::spec::EnvSpec;
 use super::square;
@@ -18,8 +20,27 @@ pub fn all() -> Vec<EnvSpec> {
     for re in pinball::REYNOLDS {
         v.push(pinball::rotary(re));
     }
+    for re in pinball::REYNOLDS {
+        v.push(pinball::jets(re));
+    }
     for re in square::REYNOLDS {
         v.push(square::square(re));
+    }
+    for re in cavity::REYNOLDS {
+        v.push(cavity::cavity(re));
+    }
+    for re in cavity::REYNOLDS {
+        v.push(cavity::cavity_3jet(re));
+    }
+    for re in naca::REYNOLDS {
+        for aoa in naca::ANGLES {
+            v.push(naca::steady(re, aoa));
+        }
+    }
+    for re in naca::REYNOLDS {
+        for aoa in naca::ANGLES {
+            v.push(naca::gust(re, aoa));
+        }
     }
     // The table is checked by a test; a broken one only means uncalibrated observations.
     let table = calibrate::parse_table(calibrate::TABLE).unwrap_or_default();

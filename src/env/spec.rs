@@ -25,6 +25,14 @@ pub enum ActuationSpec {
         span_deg: f64,
         max_velocity: f64,
     },
+    /// A zero-net-mass-flux jet pair on each of the listed circular bodies, as in `ZnmfJets`,
+    /// one action per body. Bound: `max_velocity` in units of U.
+    ZnmfJetsPerBody {
+        bodies: Vec<usize>,
+        angles_deg: [f64; 2],
+        span_deg: f64,
+        max_velocity: f64,
+    },
     /// Independent jets on one body (any shape), one action each: jet `k` blows with
     /// `a_k * max_velocity` (negative: suction). Net mass flux is not zero.
     /// Bound: `max_velocity` in units of U (peak of the parabolic jet profile).
@@ -39,6 +47,7 @@ impl ActuationSpec {
         match self {
             ActuationSpec::ZnmfJets { .. } => 1,
             ActuationSpec::Jets { jets, .. } => jets.len(),
+            ActuationSpec::ZnmfJetsPerBody { bodies, .. } => bodies.len(),
             ActuationSpec::Rotation { bodies, .. } => bodies.len(),
         }
     }
@@ -50,6 +59,16 @@ impl ActuationSpec {
 pub enum RewardSpec {
     /// `r = -sum_b |C_D,b| - w sum_b |C_L,b|` (cylinder, square cylinder, pinball).
     DragLift { lift_weight: f64 },
+    /// `r = -|sum_b C_D,b| - w |sum_b C_L,b|` (the paper's fluidic pinball).
+    TotalDragLift { lift_weight: f64 },
+    /// `r = -sum_i ((o_i - mean_i) / std_i)^2` over every observation (the paper's open cavity):
+    /// the deviation of the probes from the uncontrolled flow's mean, in units of its standard
+    /// deviation. Mean and std are the calibrated normalisation (`scale` = 3 std), so this is
+    /// `-9 sum_i obs_i^2` of the normalised observation at the end of the interval.
+    ProbeDeviation,
+    /// `r = -|C_L - c_l_ref| - w |C_D - c_d_ref|` (the paper's gust mitigation): force deviation
+    /// from the time-averaged coefficients of the undisturbed flow, with `w = drag_weight`.
+    GustLoads { c_l_ref: f64, c_d_ref: f64, drag_weight: f64 },
 }
 
 /// Observation normalisation `obs = (raw - mean) / scale`, computed by `hgym envs calibrate`
@@ -91,6 +110,33 @@ pub struct EnvSpec {
     /// Empty until calibrated.
     #[serde(default)]
     pub normalization: Normalization,
+    /// A transverse gust entering through the inlet during each episode (none: steady inflow).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust: Option<GustSpec>,
+}
+
+/// A "1 - cos" transverse gust imposed at the inflow (the paper's gust-airfoil set-up): the
+/// inlet's transverse velocity is `v(t) = (G / 2) (1 - cos(2 pi (t - start) / duration)) U` for
+/// `start <= t <= start + duration` (episode time, L/U) and zero otherwise; `G = ratio` is the
+/// peak gust velocity over U. The gust then convects with the flow towards the body.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct GustSpec {
+    pub ratio: f64,
+    pub start: f64,
+    pub duration: f64,
+}
+
+impl GustSpec {
+    /// Transverse inlet velocity (units of U) at episode time `t`.
+    pub fn velocity(&self, t: f64) -> f64 {
+        let s = (t - self.start) / self.duration;
+        if (0.0..=1.0).contains(&s) {
+            0.5 * self.ratio * (1.0 - (2.0 * std::f64::consts::PI * s).cos())
+        } else {
+            0.0
+        }
+    }
 }
 
 impl EnvSpec {
@@ -124,4 +170,29 @@ impl EnvSpec {
 /// Probes on the grid `xs x ys` (x-major), the usual wake rake.
 pub fn probe_grid(xs: &[f64], ys: &[f64]) -> Vec<[f64; 2]> {
     xs.iter().flat_map(|&x| ys.iter().map(move |&y| [x, y])).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The paper's 1 - cos gust: zero before and after, peak G at mid-duration, continuous.
+    #[test]
+    fn gust_is_one_minus_cosine_with_peak_ratio() {
+        let g = GustSpec {
+            ratio: 2.0,
+            start: 2.0,
+            duration: 2.0,
+        };
+        assert_eq!(g.velocity(1.99), 0.0);
+        assert_eq!(g.velocity(4.01), 0.0);
+        assert!((g.velocity(3.0) - 2.0).abs() < 1e-12);
+        assert!((g.velocity(2.5) - 1.0).abs() < 1e-12);
+        assert!(g.velocity(2.0).abs() < 1e-12 && g.velocity(4.0).abs() < 1e-12);
+        let mut t = 1.5;
+        while t < 4.5 {
+            assert!((g.velocity(t + 1e-4) - g.velocity(t)).abs() < 1e-3, "jump at t = {t}");
+            t += 1e-3;
+        }
+    }
 }

@@ -91,6 +91,13 @@ pub enum GeometrySpec {
         leading_edge: [f64; 2],
         aoa_deg: f64,
     },
+    /// An open cavity cut into a flat wall `y = leading_edge[1]` (the plate upstream and
+    /// downstream of it is solid down to the domain's bottom); reference length: the depth.
+    Cavity {
+        leading_edge: [f64; 2],
+        length: f64,
+        depth: f64,
+    },
 }
 
 impl GeometrySpec {
@@ -99,6 +106,7 @@ impl GeometrySpec {
             GeometrySpec::Circle { diameter, .. } => *diameter,
             GeometrySpec::Square { side, .. } => *side,
             GeometrySpec::Naca { chord, .. } => *chord,
+            GeometrySpec::Cavity { depth, .. } => *depth,
         }
     }
 
@@ -107,6 +115,11 @@ impl GeometrySpec {
         match self {
             GeometrySpec::Circle { center, .. } | GeometrySpec::Square { center, .. } => *center,
             GeometrySpec::Naca { chord, leading_edge, .. } => [leading_edge[0] + 0.5 * chord, leading_edge[1]],
+            GeometrySpec::Cavity {
+                leading_edge,
+                length,
+                depth,
+            } => [leading_edge[0] + 0.5 * length, leading_edge[1] - 0.5 * depth],
         }
     }
 }

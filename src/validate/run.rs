@@ -4,7 +4,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use hgym_solvers::geometry::{Circle, Naca4, Rectangle, Shape};
+use hgym_solvers::geometry::{Circle, Naca4, OpenCavity, Rectangle, Shape};
 use hgym_solvers::lbm::{Collision, D2q9, D2q9Config, Grid, LbmError, Side, Sides, Units};
 
 use super::case::{BoundaryKind, BoundarySpec, GeometrySpec, Level, LoadedCase, Profile, MAX_NODES};
@@ -33,6 +33,15 @@ pub fn build_shape(g: &GeometrySpec) -> Arc<dyn Shape> {
                     .unwrap_or_else(|| Naca4::new(0.0, 0.0, 0.12, *chord, *leading_edge, *aoa_deg)),
             )
         }
+        GeometrySpec::Cavity {
+            leading_edge,
+            length,
+            depth,
+        } => Arc::new(OpenCavity {
+            leading_edge: *leading_edge,
+            length: *length,
+            depth: *depth,
+        }),
     }
 }
 

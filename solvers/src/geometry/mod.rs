@@ -4,13 +4,16 @@
 //! `phi(p)`: negative inside the body, positive in the fluid, zero on the wall. Everything the
 //! lattice needs (which nodes are solid, where a lattice link crosses the wall, the wall normal)
 //! follows from `phi`, so a new shape only has to say how far a point is from it. Circles,
-//! rectangles (square cylinders), NACA 4-digit aerofoils and half-planes (channel walls) are here.
+//! rectangles (square cylinders), NACA 4-digit aerofoils, half-planes (channel walls) and open
+//! cavities are here.
 
+mod cavity;
 mod circle;
 mod naca;
 mod plane;
 mod rectangle;
 
+pub use cavity::OpenCavity;
 pub use circle::Circle;
 pub use naca::Naca4;
 pub use plane::HalfPlane;

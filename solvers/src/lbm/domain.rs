@@ -39,6 +39,26 @@ impl Side {
     }
 }
 
+/// One edge of the domain, by compass direction (west: `x = -1/2`, south: `y = -1/2`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Edge {
+    West,
+    East,
+    South,
+    North,
+}
+
+impl Edge {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Edge::West => "west",
+            Edge::East => "east",
+            Edge::South => "south",
+            Edge::North => "north",
+        }
+    }
+}
+
 /// The four edges of the domain.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sides {

@@ -24,7 +24,7 @@ mod solver;
 mod units;
 
 pub use collision::Collision;
-pub use domain::{Grid, Side, Sides};
+pub use domain::{Edge, Grid, Side, Sides};
 pub use error::LbmError;
 pub use solver::{D2q9, D2q9Config, WallPoint};
 pub use units::Units;

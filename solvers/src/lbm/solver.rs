@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use super::aligned::AlignedVec;
 use super::check::{scan_row, RowStat};
 use super::collision::{equilibrium, moments, Collision, Relax};
-use super::domain::{Grid, Side, Sides};
+use super::domain::{Edge, Grid, Side, Sides};
 use super::error::LbmError;
 use super::forces::link_forces;
 use super::kernel::{row_fn, KernelCtx, Link, Special};
@@ -449,6 +449,31 @@ impl D2q9 {
     /// Multiplies every [`Side::Velocity`] profile by `scale` from the next step on (inlet ramps).
     pub fn set_boundary_velocity_scale(&mut self, scale: f64) {
         self.velocity_scale = scale as f32;
+    }
+
+    /// Sets every node of the [`Side::Velocity`] edge `edge` to the lattice velocity `u` from the
+    /// next step on: time-dependent inflow (a gust, a pulsatile inlet). Allocates nothing.
+    pub fn set_side_velocity(&mut self, edge: Edge, u: [f64; 2]) -> Result<(), LbmError> {
+        if !(u[0].is_finite() && u[1].is_finite()) {
+            return Err(config_error("sides", format!("the {} velocity {u:?} is not finite", edge.name())));
+        }
+        let s = &mut self.cfg.sides;
+        let side = match edge {
+            Edge::West => &mut s.west,
+            Edge::East => &mut s.east,
+            Edge::South => &mut s.south,
+            Edge::North => &mut s.north,
+        };
+        match side {
+            Side::Velocity { profile } => {
+                profile.fill([u[0] as f32, u[1] as f32]);
+                Ok(())
+            }
+            other => Err(config_error(
+                "sides",
+                format!("the {} edge is a {} side, not a velocity side", edge.name(), other.name()),
+            )),
+        }
     }
 
     /// Sets the wall velocity (lattice units) of every link of `body` from its wall point:

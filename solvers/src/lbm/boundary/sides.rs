@@ -2,17 +2,9 @@
 //! domain (see [`Side`] for the equations).
 
 use super::super::collision::moments;
-use super::super::domain::Side;
+use super::super::domain::{Edge, Side};
 use super::super::kernel::KernelCtx;
 use super::super::lattice::{CX, CY, OPP, Q, W};
-
-#[derive(Clone, Copy)]
-enum Edge {
-    West,
-    East,
-    South,
-    North,
-}
 
 /// Value entering node `(x, y)` in direction `k` from outside the domain.
 #[inline]

@@ -1,0 +1,140 @@
+//! Open cavity family (HydroGym "Open cavity flow"): `Cavity_2D_Re{4200,7500}` with one jet at
+//! the cavity's leading edge, and `Cavity3Jet_2D_Re{...}` with two more jets inside the cavity.
+//!
+//! Set-up from the paper (after Barbagallo, Sipp & Schmid 2009): a square cavity of depth D = 1
+//! (the reference length) at `x in [0.27, 1.27]`, `y in [0, 1]`, in the domain `[0, 2.5] x [0, 1.5]`;
+//! uniform inflow `(U, 0)` at `x = 0`, free-slip (symmetry) top, open outlet, no-slip cavity walls
+//! and plate. One difference: the paper keeps the plate free-slip for `x < 0.1777` to set the
+//! boundary layer's thickness; here the plate is no-slip from the inlet, so the boundary layer
+//! grows over 0.27 D and reaches a Blasius displacement thickness `1.72 sqrt(0.27 / Re)` at the
+//! leading edge: 0.0103 D at Re 7500 and 0.0138 D at Re 4200, against the paper's target of
+//! about 0.012 D.
+//!
+//! Observations: (u, v, p) at 12 probes, 8 along the shear layer over the cavity opening
+//! (`y = 1.0` and `1.1`, four stations) and 4 inside the cavity. Reward, as the paper defines it:
+//! `r = -sum_i ((o_i - mean_i) / std_i)^2` over every observation, with mean and std of the
+//! uncontrolled flow (the calibrated normalisation; the paper averages over 1000 cycles, we use
+//! the calibration run).
+//!
+//! Actuation: the standard configuration is one jet at the leading edge blowing in +y, on the
+//! plate 0.03 D upstream of the lip, 0.05 D wide (two cells at the coarse level); the 3-jet
+//! variant adds jets at (1.27, 0.75) on the aft wall and (0.27, 0.5) on the front wall, blowing
+//! streamwise into the cavity (positive action: out of the wall), 0.1 D wide. Bound: jet peak
+//! velocity 0.5 U each (a fraction of U, as cavity actuators are weak; overridable).
+//!
+//! Timing: the uncontrolled flow oscillates with the shear-layer (Rossiter) mode; the control
+//! interval is 0.04 D/U (about a twentieth of the period at Re 7500), 200 actions per episode.
+//! Spin-up: 120 D/U from the uniform flow (the oscillation saturates slowly near the critical Re).
+//! Subgrid: Smagorinsky `C_s = 0.1`, which the regularised solver needs at these Re on the coarse
+//! grid.
+
+use super::actuation::{Jet, Ramp};
+use super::spec::{probe_grid, ActuationSpec, EnvSpec, Normalization, RewardSpec};
+use crate::validate::case::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
+
+pub const REYNOLDS: [u32; 2] = [4200, 7500];
+
+/// The upstream lip of the cavity, its length and depth.
+pub const LEADING_EDGE: [f64; 2] = [0.27, 1.0];
+pub const LENGTH: f64 = 1.0;
+pub const DEPTH: f64 = 1.0;
+
+fn probes() -> Vec<[f64; 2]> {
+    let mut p = probe_grid(&[0.45, 0.7, 0.95, 1.2], &[1.0, 1.1]);
+    p.extend(probe_grid(&[0.5, 1.05], &[0.4, 0.8]));
+    p
+}
+
+/// The leading-edge jet: on the plate just upstream of the lip, blowing in +y.
+fn leading_edge_jet() -> Jet {
+    Jet {
+        center: [LEADING_EDGE[0] - 0.03, LEADING_EDGE[1]],
+        angle_deg: 90.0,
+        width: 0.05,
+    }
+}
+
+/// The two jets inside the cavity (paper: at (1.277, 0.75) and (0.277, 0.5), streamwise).
+fn inner_jets() -> [Jet; 2] {
+    let x_aft = LEADING_EDGE[0] + LENGTH;
+    [
+        Jet {
+            center: [x_aft, 0.75],
+            angle_deg: 180.0,
+            width: 0.1,
+        },
+        Jet {
+            center: [LEADING_EDGE[0], 0.5],
+            angle_deg: 0.0,
+            width: 0.1,
+        },
+    ]
+}
+
+fn base(id: String, family: &str, re: u32, jets: Vec<Jet>, description: String) -> EnvSpec {
+    EnvSpec {
+        id,
+        family: family.into(),
+        description,
+        reynolds: re as f64,
+        bodies: vec![GeometrySpec::Cavity {
+            leading_edge: LEADING_EDGE,
+            length: LENGTH,
+            depth: DEPTH,
+        }],
+        domain: DomainSpec {
+            x: [0.0, 2.5],
+            y: [0.0, 1.5],
+        },
+        boundaries: BoundarySpec {
+            west: BoundaryKind::Inlet,
+            east: BoundaryKind::Outlet,
+            south: BoundaryKind::Wall,
+            north: BoundaryKind::FreeSlip,
+        },
+        resolution: ResolutionSpec {
+            coarse: 40,
+            default: 128,
+            fine: 200,
+        },
+        lattice_velocity: 0.05,
+        collision: hgym_solvers::lbm::Collision::Regularized,
+        smagorinsky: 0.1,
+        actuation: ActuationSpec::Jets {
+            body: 0,
+            jets,
+            max_velocity: 0.5,
+        },
+        ramp: Ramp::default(),
+        probes: probes(),
+        reward: RewardSpec::ProbeDeviation,
+        control_interval: 0.04,
+        episode_actions: 200,
+        spin_up: 120.0,
+        normalization: Normalization::default(),
+        gust: None,
+    }
+}
+
+/// `Cavity_2D_Re{re}`: the leading-edge jet.
+pub fn cavity(re: u32) -> EnvSpec {
+    base(
+        format!("Cavity_2D_Re{re}"),
+        "cavity",
+        re,
+        vec![leading_edge_jet()],
+        format!("2D open square cavity at Re {re} (depth-based), one jet at the leading edge"),
+    )
+}
+
+/// `Cavity3Jet_2D_Re{re}`: the leading-edge jet and two streamwise jets inside the cavity.
+pub fn cavity_3jet(re: u32) -> EnvSpec {
+    let [aft, front] = inner_jets();
+    base(
+        format!("Cavity3Jet_2D_Re{re}"),
+        "cavity_3jet",
+        re,
+        vec![leading_edge_jet(), aft, front],
+        format!("2D open square cavity at Re {re}, leading-edge jet and two jets inside the cavity"),
+    )
+}
