@@ -105,8 +105,8 @@ fn same_seed_same_actions_same_trajectory() {
 /// after a reset.
 #[test]
 fn gust_reaches_the_inlet_and_lifts_the_aerofoil() {
-    let steady = registry::get("NACA0012_2D_Re100_AoA20").unwrap();
-    let mut gusty = registry::get("NACA0012Gust_2D_Re100_AoA20").unwrap();
+    let steady = registry::get("NACA0012_2D_Re1000_AoA20").unwrap();
+    let mut gusty = registry::get("NACA0012Gust_2D_Re1000_AoA20").unwrap();
     assert_eq!(gusty.gust.as_ref().map(|g| g.ratio), Some(2.0), "the gust ID has a G = 2 gust");
     gusty.gust.as_mut().unwrap().start = 0.0;
     let g = gusty.gust.clone().unwrap();
@@ -165,7 +165,7 @@ fn gust_reaches_the_inlet_and_lifts_the_aerofoil() {
 /// it injects mass (a jet placed off the wall, or narrower than the grid, would inject none).
 #[test]
 fn every_independent_jet_reaches_the_wall_at_the_default_level() {
-    for spec in registry::all() {
+    for spec in registry::all().into_iter().chain(hgym::env::cavity::specs()) {
         if !matches!(spec.actuation, ActuationSpec::Jets { .. }) {
             continue;
         }

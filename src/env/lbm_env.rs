@@ -247,13 +247,27 @@ impl LbmEnv {
                 }
             }
         }
-        // Spin up from the uniform flow with a transverse kick just behind the last body.
+        // Spin up from the uniform flow with a transverse kick just behind the last body; fluid
+        // below a cavity's lips starts at rest (an impulsive start with U inside the cavity sheds
+        // vortices that the thin layer above it keeps for tens of time units).
         let u = self.spec.lattice_velocity;
+        let below_lips: Vec<f64> = self
+            .spec
+            .bodies
+            .iter()
+            .filter_map(|b| match b {
+                GeometrySpec::Cavity { leading_edge, .. } => Some(leading_edge[1]),
+                _ => None,
+            })
+            .collect();
         let centers: Vec<[f64; 2]> = self.spec.bodies.iter().map(|b| b.center()).collect();
         let x_back = centers.iter().map(|c| c[0]).fold(f64::NEG_INFINITY, f64::max);
         let y_mid = centers.iter().map(|c| c[1]).sum::<f64>() / centers.len().max(1) as f64;
         let c = if centers.is_empty() { [0.0, 0.0] } else { [x_back, y_mid] };
         self.solver.init_with(|x, y| {
+            if below_lips.iter().any(|&y_top| y < y_top) {
+                return (1.0, 0.0, 0.0);
+            }
             let r2 = (x - c[0] - 1.0).powi(2) + (y - c[1] - 0.25).powi(2);
             (1.0, u, 0.3 * u * (-4.0 * r2).exp())
         });

@@ -100,13 +100,14 @@ fn control_interval() -> f64 {
 }
 
 /// Time-averaged (C_L, C_D) of the undisturbed flow at the default level, the gust reward's
-/// reference (measured: see the module docs for the command).
-pub fn reference_coefficients(re: u32, aoa: u32) -> (f64, f64) {
+/// reference: the `mean_forces` that `hgym envs calibrate NACA0012_2D_Re{re}_AoA{aoa}` recorded in
+/// `benchmarks/envs/normalization.toml` (100 actions = 10 c/U). `None` where not measured yet; the
+/// registry lists a gust ID only when its reference exists.
+pub fn reference_coefficients(re: u32, aoa: u32) -> Option<(f64, f64)> {
     match (re, aoa) {
-        (100, 20) => (0.0, 0.0),
-        (100, _) => (0.0, 0.0),
-        (_, 20) => (0.0, 0.0),
-        _ => (0.0, 0.0),
+        // Calibrated 2026-11-23 (default level, 100 actions): C_D 0.4776, C_L 0.8761.
+        (1000, 20) => Some((0.8761, 0.4776)),
+        _ => None,
     }
 }
 
@@ -159,13 +160,14 @@ pub fn steady(re: u32, aoa: u32) -> EnvSpec {
     }
 }
 
-/// `NACA0012Gust_2D_Re{re}_AoA{aoa}`: the same flow hit by a G = 2 transverse gust each episode.
-pub fn gust(re: u32, aoa: u32) -> EnvSpec {
+/// `NACA0012Gust_2D_Re{re}_AoA{aoa}`: the same flow hit by a G = 2 transverse gust each episode;
+/// `None` until the undisturbed flow's reference forces are measured.
+pub fn gust(re: u32, aoa: u32) -> Option<EnvSpec> {
+    let (c_l_ref, c_d_ref) = reference_coefficients(re, aoa)?;
     let mut s = steady(re, aoa);
     s.id = format!("NACA0012Gust_2D_Re{re}_AoA{aoa}");
     s.family = "naca0012_gust".into();
     s.description = format!("2D NACA 0012 at Re {re}, {aoa} degrees, G = 2 transverse 1 - cos gust, three leading-edge jets");
-    let (c_l_ref, c_d_ref) = reference_coefficients(re, aoa);
     s.reward = RewardSpec::GustLoads {
         c_l_ref,
         c_d_ref,
@@ -176,7 +178,7 @@ pub fn gust(re: u32, aoa: u32) -> EnvSpec {
         start: 2.0,
         duration: 2.0,
     });
-    s
+    Some(s)
 }
 
 #[cfg(test)]

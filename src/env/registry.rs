@@ -1,7 +1,6 @@
 //! Every environment ID and its spec.
 
 use super::calibrate;
-use super::cavity;
 use super::cylinder;
 use super::naca;
 use super::pinball;
@@ -26,12 +25,7 @@ pub fn all() -> Vec<EnvSpec> {
     for re in square::REYNOLDS {
         v.push(square::square(re));
     }
-    for re in cavity::REYNOLDS {
-        v.push(cavity::cavity(re));
-    }
-    for re in cavity::REYNOLDS {
-        v.push(cavity::cavity_3jet(re));
-    }
+    // The open cavity (`cavity::specs()`) is not registered yet: see the module's docs.
     for re in naca::REYNOLDS {
         for aoa in naca::ANGLES {
             v.push(naca::steady(re, aoa));
@@ -39,7 +33,7 @@ pub fn all() -> Vec<EnvSpec> {
     }
     for re in naca::REYNOLDS {
         for aoa in naca::ANGLES {
-            v.push(naca::gust(re, aoa));
+            v.extend(naca::gust(re, aoa));
         }
     }
     // The table is checked by a test; a broken one only means uncalibrated observations.
