@@ -35,6 +35,7 @@
 //! - the wall force includes the absolute lattice pressure on this open body (the plate runs
 //!   through the inlet and outlet), so `C_L` has an offset of about -1100; the reward does not
 //!   use forces, but `info` should report the force relative to the far-field pressure.
+//!
 //! Next: a non-reflecting or sponge top boundary (or an outlet-type top) to absorb the acoustic
 //! mode, then calibrate, check the shear-layer frequency against Barbagallo et al. (2009), and
 //! register the IDs.

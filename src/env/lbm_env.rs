@@ -247,25 +247,16 @@ impl LbmEnv {
                 }
             }
         }
-        // Spin up from the uniform flow with a transverse kick just behind the last body; fluid
-        // below a cavity's lips starts at rest (an impulsive start with U inside the cavity sheds
-        // vortices that the thin layer above it keeps for tens of time units).
+        // Spin up from the uniform flow with a transverse kick just behind the last body (fluid
+        // that a body says starts at rest, at rest).
         let u = self.spec.lattice_velocity;
-        let below_lips: Vec<f64> = self
-            .spec
-            .bodies
-            .iter()
-            .filter_map(|b| match b {
-                GeometrySpec::Cavity { leading_edge, .. } => Some(leading_edge[1]),
-                _ => None,
-            })
-            .collect();
+        let bodies = &self.spec.bodies;
         let centers: Vec<[f64; 2]> = self.spec.bodies.iter().map(|b| b.center()).collect();
         let x_back = centers.iter().map(|c| c[0]).fold(f64::NEG_INFINITY, f64::max);
         let y_mid = centers.iter().map(|c| c[1]).sum::<f64>() / centers.len().max(1) as f64;
         let c = if centers.is_empty() { [0.0, 0.0] } else { [x_back, y_mid] };
         self.solver.init_with(|x, y| {
-            if below_lips.iter().any(|&y_top| y < y_top) {
+            if bodies.iter().any(|b| b.starts_at_rest([x, y])) {
                 return (1.0, 0.0, 0.0);
             }
             let r2 = (x - c[0] - 1.0).powi(2) + (y - c[1] - 0.25).powi(2);
@@ -292,16 +283,17 @@ impl LbmEnv {
         Ok(state)
     }
 
-    /// Mass (lattice units per step) that each actuator alone injects at its full positive bound,
-    /// summed over the bodies: nonzero for a jet that reaches wall links, zero for a rotation or a
-    /// zero-net-mass-flux pair. Leaves the actuators at rest. For tests and diagnostics.
-    pub fn actuator_mass_sources(&mut self) -> Vec<f64> {
+    /// Mass (lattice units per step) that each actuator alone injects at `action` (in [-1, 1],
+    /// a fraction of its bound), summed over the bodies: nonzero for a jet that reaches wall
+    /// links, zero for a rotation or a zero-net-mass-flux pair. Leaves the actuators at rest.
+    /// For tests and diagnostics.
+    pub fn actuator_mass_sources(&mut self, action: f64) -> Vec<f64> {
         let dim = self.spec.act_dim();
         let bound = self.bound();
         let mut out = Vec::with_capacity(dim);
         for k in 0..dim {
             let mut a = vec![0.0; dim];
-            a[k] = bound;
+            a[k] = action * bound;
             self.actuate(&a);
             out.push((0..self.spec.bodies.len()).map(|b| self.solver.wall_mass_source(b)).sum());
         }
@@ -401,9 +393,7 @@ impl Env for LbmEnv {
                 *v = self.spec.ramp.blend(self.a_old[k], a_new[k], tau);
             }
             self.actuate(&now);
-            if self.spec.gust.is_some() {
-                self.set_gust(self.time())?;
-            }
+            self.set_gust(self.time())?;
             if let Err(e) = self.solver.step() {
                 diverged = Some(e.to_string());
                 break;
@@ -469,11 +459,9 @@ pub fn reward(spec: &RewardSpec, info: &Info, obs: &[f64], n_bodies: usize) -> f
             r
         }
         RewardSpec::TotalDragLift { lift_weight } => {
-            let (mut c_d, mut c_l) = (0.0, 0.0);
-            for b in 0..n_bodies {
-                c_d += info.get(&format!("C_D_{b}")).unwrap_or(0.0);
-                c_l += info.get(&format!("C_L_{b}")).unwrap_or(0.0);
-            }
+            // `C_D` and `C_L` in `info` are the sums over the bodies.
+            let c_d = info.get("C_D").unwrap_or(0.0);
+            let c_l = info.get("C_L").unwrap_or(0.0);
             -c_d.abs() - lift_weight * c_l.abs()
         }
         RewardSpec::ProbeDeviation => -9.0 * obs.iter().map(|o| o * o).sum::<f64>(),

@@ -22,59 +22,52 @@
 //! Rewards. Steady inflow: the bluff-body reward `-|C_D| - w |C_L|` with `w = 0.1` at Re 100 and
 //! 1.0 at Re 1000 (the cylinder's weights; the paper lists wake stabilisation without a formula).
 //! Gust: the paper's `-|C_L - C_L,ref| - 0.25 |C_D - C_D,ref|` with the reference coefficients
-//! the time-averaged ones of the undisturbed flow, measured here at the default level
-//! (`hgym run --env NACA0012_2D_Re{re}_AoA{a} --policy zero --steps 200 --res default`, mean of
-//! C_L and C_D over the 200 actions; see [`reference_coefficients`]).
+//! the time-averaged ones of the undisturbed flow, measured here at the default level by
+//! `hgym envs calibrate NACA0012_2D_Re{re}_AoA{a}` (see [`reference_coefficients`]).
 //!
 //! Gust: `G = 2` (peak transverse velocity 2 U), 1 - cos in time over 2 c/U, entering the inlet at
 //! episode time 2 c/U, so it reaches the leading edge after about 8.5 c/U and has passed by 13.
 //! Timing: control interval 0.1 c/U (a twentieth of the shedding period at 20 degrees, St based on
 //! the chord about 0.5), 200 actions = 20 c/U per episode. Spin-up 40 c/U.
 
-use super::actuation::{Jet, Ramp};
-use super::spec::{probe_grid, ActuationSpec, EnvSpec, GustSpec, Normalization, RewardSpec};
-use crate::validate::case::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
+use hgym_solvers::geometry::Naca4;
+
+use super::actuation::Jet;
+use super::cylinder::bluff_body;
+use super::spec::{probe_grid, ActuationSpec, EnvSpec, GustSpec, RewardSpec};
+use crate::validate::case::{DomainSpec, GeometrySpec, ResolutionSpec};
 
 pub const REYNOLDS: [u32; 2] = [100, 1000];
 pub const ANGLES: [u32; 2] = [20, 40];
 
 pub const LEADING_EDGE: [f64; 2] = [6.5, 0.0];
-const THICKNESS: f64 = 0.12;
+const DIGITS: &str = "0012";
 /// Chord fractions of the three jet centres, and the jet width (fraction of the chord).
 const JET_STATIONS: [f64; 3] = [0.02, 0.05, 0.08];
 const JET_WIDTH: f64 = 0.03;
 
-/// NACA 00xx half-thickness `y_t(x)` (closed trailing edge) and its slope, in chords.
-fn half_thickness(x: f64) -> (f64, f64) {
-    let t = THICKNESS;
-    let yt = 5.0 * t * (0.2969 * x.sqrt() - 0.1260 * x - 0.3516 * x * x + 0.2843 * x.powi(3) - 0.1036 * x.powi(4));
-    let dyt = 5.0 * t * (0.5 * 0.2969 / x.sqrt() - 0.1260 - 2.0 * 0.3516 * x + 3.0 * 0.2843 * x * x - 4.0 * 0.1036 * x.powi(3));
-    (yt, dyt)
-}
-
-/// Body coordinates (x along the chord from the leading edge) -> physical, for the nose-up
-/// rotation by `aoa_deg` about the leading edge (the inverse of `Naca4::to_body`).
-fn to_physical(b: [f64; 2], aoa_deg: f64) -> [f64; 2] {
-    let a = aoa_deg.to_radians();
-    [
-        LEADING_EDGE[0] + b[0] * a.cos() + b[1] * a.sin(),
-        LEADING_EDGE[1] - b[0] * a.sin() + b[1] * a.cos(),
-    ]
+/// The aerofoil at angle of attack `aoa_deg` (chord 1): the shape the solver builds from the spec.
+fn aerofoil(aoa_deg: f64) -> Naca4 {
+    // DIGITS is a valid code; the fallback is the same symmetric 12 % section.
+    Naca4::from_digits(DIGITS, 1.0, LEADING_EDGE, aoa_deg).unwrap_or_else(|| Naca4::new(0.0, 0.0, 0.12, 1.0, LEADING_EDGE, aoa_deg))
 }
 
 /// The three suction-side jets at angle of attack `aoa_deg`.
 pub fn jets(aoa_deg: f64) -> Vec<Jet> {
+    let body = aerofoil(aoa_deg);
     JET_STATIONS
         .iter()
         .map(|&x| {
-            let (yt, dyt) = half_thickness(x);
-            // Outward normal of the upper surface in body coordinates, rotated like the body.
+            let (yt, dyt) = Naca4::half_thickness(body.t, x);
+            // Outward normal of the upper surface in body coordinates, mapped like the body
+            // (the difference of its mapped end points).
             let nb = [-dyt, 1.0];
-            let p0 = to_physical([0.0, 0.0], aoa_deg);
-            let pn = to_physical(nb, aoa_deg);
+            let to_physical = |b| body.to_physical(b);
+            let p0 = to_physical([0.0, 0.0]);
+            let pn = to_physical(nb);
             let n = [pn[0] - p0[0], pn[1] - p0[1]];
             Jet {
-                center: to_physical([x, yt], aoa_deg),
+                center: to_physical([x, yt]),
                 angle_deg: n[1].atan2(n[0]).to_degrees(),
                 width: JET_WIDTH,
             }
@@ -83,7 +76,7 @@ pub fn jets(aoa_deg: f64) -> Vec<Jet> {
 }
 
 fn probes() -> Vec<[f64; 2]> {
-    let c = to_physical([0.5, 0.0], 0.0);
+    let c = [LEADING_EDGE[0] + 0.5, LEADING_EDGE[1]];
     let mut p: Vec<[f64; 2]> = (0..12)
         .map(|k| {
             let th = 2.0 * std::f64::consts::PI * k as f64 / 12.0;
@@ -93,10 +86,6 @@ fn probes() -> Vec<[f64; 2]> {
     p.extend(probe_grid(&[8.5, 9.5], &[-1.2, -0.6, 0.0, 0.6]));
     p.extend(probe_grid(&[4.5], &[-0.75, -0.25, 0.25, 0.75]));
     p
-}
-
-fn control_interval() -> f64 {
-    0.1
 }
 
 /// Time-averaged (C_L, C_D) of the undisturbed flow at the default level, the gust reward's
@@ -111,53 +100,42 @@ pub fn reference_coefficients(re: u32, aoa: u32) -> Option<(f64, f64)> {
     }
 }
 
-/// `NACA0012_2D_Re{re}_AoA{aoa}`.
+/// `NACA0012_2D_Re{re}_AoA{aoa}`: the paper's 2D bluff-body set-up (inflow, periodic sides,
+/// outlet, regularised collision with C_s 0.1 from Re 1000, ramp, `-|C_D| - w|C_L|` with the
+/// cylinder's `w`, 200 actions) with this family's domain, grid, lattice velocity, probes, timing
+/// and spin-up.
 pub fn steady(re: u32, aoa: u32) -> EnvSpec {
-    EnvSpec {
-        id: format!("NACA0012_2D_Re{re}_AoA{aoa}"),
-        family: "naca0012".into(),
-        description: format!("2D NACA 0012 at Re {re} (chord), {aoa} degrees, three leading-edge jets"),
-        reynolds: re as f64,
-        bodies: vec![GeometrySpec::Naca {
-            digits: "0012".into(),
+    let mut s = bluff_body(
+        format!("NACA0012_2D_Re{re}_AoA{aoa}"),
+        "naca0012",
+        re,
+        GeometrySpec::Naca {
+            digits: DIGITS.into(),
             chord: 1.0,
             leading_edge: LEADING_EDGE,
             aoa_deg: aoa as f64,
-        }],
-        domain: DomainSpec {
-            x: [0.0, 20.0],
-            y: [-6.0, 6.0],
         },
-        boundaries: BoundarySpec {
-            west: BoundaryKind::Inlet,
-            east: BoundaryKind::Outlet,
-            south: BoundaryKind::Periodic,
-            north: BoundaryKind::Periodic,
-        },
-        resolution: ResolutionSpec {
-            coarse: 16,
-            default: 64,
-            fine: 100,
-        },
-        lattice_velocity: 0.04,
-        collision: hgym_solvers::lbm::Collision::Regularized,
-        smagorinsky: if re >= 1000 { 0.1 } else { 0.0 },
-        actuation: ActuationSpec::Jets {
+        ActuationSpec::Jets {
             body: 0,
             jets: jets(aoa as f64),
             max_velocity: 1.0,
         },
-        ramp: Ramp::default(),
-        probes: probes(),
-        reward: RewardSpec::DragLift {
-            lift_weight: if re >= 1000 { 1.0 } else { 0.1 },
-        },
-        control_interval: control_interval(),
-        episode_actions: 200,
-        spin_up: 40.0,
-        normalization: Normalization::default(),
-        gust: None,
-    }
+        format!("2D NACA 0012 at Re {re} (chord), {aoa} degrees, three leading-edge jets"),
+        0.1,
+    );
+    s.domain = DomainSpec {
+        x: [0.0, 20.0],
+        y: [-6.0, 6.0],
+    };
+    s.resolution = ResolutionSpec {
+        coarse: 16,
+        default: 64,
+        fine: 100,
+    };
+    s.lattice_velocity = 0.04;
+    s.probes = probes();
+    s.spin_up = 40.0;
+    s
 }
 
 /// `NACA0012Gust_2D_Re{re}_AoA{aoa}`: the same flow hit by a G = 2 transverse gust each episode;

@@ -52,8 +52,8 @@ pub fn bodies() -> Vec<GeometrySpec> {
 /// on each cylinder (10 degrees wide, peak bound 1.0 U, as the cylinder family's), one action per
 /// cylinder. The paper's standard pinball uses rotation and leaves jets to users; this is that
 /// variant with HydroGym's name. Same flow, reward and timing as `Pinball_2D_Re{re}`, so the two
-/// share the developed-flow state only if their physics hashes agree (they do not: the actuator
-/// is part of the spec), and each is calibrated on its own.
+/// share the developed-flow state (the cache key leaves the actuators out); each is calibrated on
+/// its own (its observation statistics are keyed on the whole spec).
 pub fn jets(re: u32) -> EnvSpec {
     let mut s = rotary(re);
     s.id = format!("JetPinball_2D_Re{re}");

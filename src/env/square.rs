@@ -76,56 +76,18 @@ pub fn square(re: u32) -> EnvSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::env::actuation::{apply, WallMotion};
+    use crate::env::LbmEnv;
     use crate::validate::case::Level;
-    use crate::validate::run::build_shape;
-    use hgym_solvers::lbm::{D2q9, D2q9Config, Grid, Side, Sides, Units};
 
     /// On the env's own grid at every level, each of the four jets reaches wall links: blowing
     /// injects mass, suction removes the same amount, and the mirror pairs (upper/lower) inject
     /// the same to round-off.
     #[test]
     fn every_jet_is_resolved_at_every_level_and_mirror_jets_agree() {
-        let spec = square(200);
-        let jets = jets();
         for level in [Level::Coarse, Level::Default, Level::Fine] {
-            let n = spec.cells_per_length(level) as f64;
-            let units = Units {
-                cells_per_length: n,
-                u_lattice: spec.lattice_velocity,
-                reynolds: spec.reynolds,
-            };
-            let d = &spec.domain;
-            let (nx, ny) = (((d.x[1] - d.x[0]) * n).round() as usize, ((d.y[1] - d.y[0]) * n).round() as usize);
-            let wall = Sides {
-                west: Side::Wall,
-                east: Side::Wall,
-                south: Side::Wall,
-                north: Side::Wall,
-            };
-            let mut cfg = D2q9Config::new(nx, ny, units.tau(), wall);
-            cfg.grid = Grid {
-                origin: [d.x[0] + 0.5 / n, d.y[0] + 0.5 / n],
-                dx: 1.0 / n,
-            };
-            let mut s = D2q9::new(cfg, vec![build_shape(&spec.bodies[0])]).unwrap();
-            let mut source = |k: usize, a: f64| {
-                let mut amp = [0.0; 4];
-                amp[k] = a;
-                apply(
-                    &mut s,
-                    0,
-                    &WallMotion {
-                        jets: &jets,
-                        amplitudes: &amp,
-                        rotation: None,
-                    },
-                    &units,
-                );
-                s.wall_mass_source(0)
-            };
-            let blow: Vec<f64> = (0..4).map(|k| source(k, 1.0)).collect();
-            let suck: Vec<f64> = (0..4).map(|k| source(k, -1.0)).collect();
+            let mut env = LbmEnv::new(square(200), level, None).unwrap();
+            let blow = env.actuator_mass_sources(1.0);
+            let suck = env.actuator_mass_sources(-1.0);
             println!("{level:?}: mass injected per step by each jet at full blowing {blow:?}");
             for k in 0..4 {
                 assert!(blow[k] > 1e-4, "{level:?}: jet {k} reaches no wall link ({})", blow[k]);

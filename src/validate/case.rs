@@ -110,6 +110,16 @@ impl GeometrySpec {
         }
     }
 
+    /// Whether fluid at `p` starts at rest when a flow is spun up from the uniform stream: below
+    /// a cavity's lips (an impulsive start with U inside the cavity sheds vortices that the thin
+    /// layer above it keeps for tens of time units); nowhere for the other shapes.
+    pub fn starts_at_rest(&self, p: [f64; 2]) -> bool {
+        match self {
+            GeometrySpec::Cavity { leading_edge, .. } => p[1] < leading_edge[1],
+            _ => false,
+        }
+    }
+
     /// A point at the body's centre (for the initial perturbation).
     pub fn center(&self) -> [f64; 2] {
         match self {

@@ -1,7 +1,7 @@
 //! Open cavity: a flat wall at `y = y_top` with a rectangular cut of `length x depth` whose
 //! upstream (leading) edge is at `x = x0` (Sipp & Lebedev 2007; Barbagallo, Sipp & Schmid 2009).
 
-use super::Shape;
+use super::{Rectangle, Shape};
 
 /// Solid region `{y < y_top} \ {x0 < x < x0 + length, y > y_top - depth}`: the plate upstream
 /// and downstream of the cavity, and the cavity's front wall, floor and aft wall.
@@ -14,16 +14,15 @@ pub struct OpenCavity {
 }
 
 impl OpenCavity {
-    /// Signed distance to the cut-out box `[x0, x0 + L] x [y_top - D, y_top + H]` (H large, so
-    /// that the box's top never reaches the fluid of interest).
-    fn box_sdf(&self, p: [f64; 2]) -> f64 {
+    /// The cut-out box `[x0, x0 + L] x [y_top - D, y_top + H]` (H large, so that the box's top
+    /// never reaches the fluid of interest).
+    fn cut(&self) -> Rectangle {
         let h = 1e3 * (self.length + self.depth);
         let [x0, yt] = self.leading_edge;
-        let c = [x0 + 0.5 * self.length, yt - self.depth + 0.5 * h];
-        let dx = (p[0] - c[0]).abs() - 0.5 * self.length;
-        let dy = (p[1] - c[1]).abs() - 0.5 * h;
-        let (ox, oy) = (dx.max(0.0), dy.max(0.0));
-        (ox * ox + oy * oy).sqrt() + dx.max(dy).min(0.0)
+        Rectangle {
+            center: [x0 + 0.5 * self.length, yt - self.depth + 0.5 * h],
+            size: [self.length, h],
+        }
     }
 }
 
@@ -32,7 +31,7 @@ impl Shape for OpenCavity {
     /// the outside of the cut. Exact away from the two lips' convex corners, where it is a lower
     /// bound of the distance with the right zero set (all the lattice needs).
     fn sdf(&self, p: [f64; 2]) -> f64 {
-        (p[1] - self.leading_edge[1]).max(-self.box_sdf(p))
+        (p[1] - self.leading_edge[1]).max(-self.cut().sdf(p))
     }
 
     fn bounding_box(&self) -> [f64; 4] {
@@ -60,7 +59,7 @@ mod tests {
         assert!((c.sdf([0.1, 0.9]) + 0.1).abs() < 1e-12); // in the upstream plate
         assert!((c.sdf([1.5, 0.9]) + 0.1).abs() < 1e-12); // in the downstream plate
         assert!(c.sdf([0.77, -0.1]) < 0.0); // below the floor
-                                            // The wall fraction along a vertical link through the front wall's lip region.
+                                            // The wall fraction along a horizontal link from the cavity into its front wall.
         let q = c.wall_fraction([0.3, 0.95], [0.25, 0.95]);
         assert!((q - 0.6).abs() < 1e-9, "q = {q}");
     }

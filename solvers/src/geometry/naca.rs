@@ -39,7 +39,7 @@ impl Naca4 {
             // Cosine spacing clusters points at the leading and trailing edges.
             let beta = std::f64::consts::PI * k as f64 / n as f64;
             let x = 0.5 * (1.0 - beta.cos());
-            let yt = 5.0 * t * (0.2969 * x.sqrt() - 0.1260 * x - 0.3516 * x * x + 0.2843 * x.powi(3) - 0.1036 * x.powi(4));
+            let yt = Self::half_thickness(t, x).0;
             let (yc, dyc) = if m == 0.0 || p == 0.0 {
                 (0.0, 0.0)
             } else if x < p {
@@ -66,6 +66,24 @@ impl Naca4 {
             aoa_deg,
             outline,
         }
+    }
+
+    /// Half-thickness `y_t(x)` of a section of thickness `t` (fractions of the chord, closed
+    /// trailing edge) and its slope `dy_t/dx`.
+    pub fn half_thickness(t: f64, x: f64) -> (f64, f64) {
+        let yt = 5.0 * t * (0.2969 * x.sqrt() - 0.1260 * x - 0.3516 * x * x + 0.2843 * x.powi(3) - 0.1036 * x.powi(4));
+        let dyt = 5.0 * t * (0.5 * 0.2969 / x.sqrt() - 0.1260 - 2.0 * 0.3516 * x + 3.0 * 0.2843 * x * x - 4.0 * 0.1036 * x.powi(3));
+        (yt, dyt)
+    }
+
+    /// Body coordinates (x along the chord from the leading edge) -> physical: the nose-up
+    /// rotation about the leading edge, then the translation (the inverse of `to_body`).
+    pub fn to_physical(&self, b: [f64; 2]) -> [f64; 2] {
+        let a = self.aoa_deg.to_radians();
+        [
+            self.leading_edge[0] + b[0] * a.cos() + b[1] * a.sin(),
+            self.leading_edge[1] - b[0] * a.sin() + b[1] * a.cos(),
+        ]
     }
 
     /// Physical point -> body coordinates (undo translation and the nose-up rotation).

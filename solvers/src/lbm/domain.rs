@@ -73,6 +73,25 @@ pub struct Sides {
 }
 
 impl Sides {
+    /// The rule at `edge`.
+    pub fn get(&self, edge: Edge) -> &Side {
+        match edge {
+            Edge::West => &self.west,
+            Edge::East => &self.east,
+            Edge::South => &self.south,
+            Edge::North => &self.north,
+        }
+    }
+
+    pub fn get_mut(&mut self, edge: Edge) -> &mut Side {
+        match edge {
+            Edge::West => &mut self.west,
+            Edge::East => &mut self.east,
+            Edge::South => &mut self.south,
+            Edge::North => &mut self.north,
+        }
+    }
+
     /// Periodic in both directions.
     pub fn periodic() -> Self {
         Sides {

@@ -457,14 +457,7 @@ impl D2q9 {
         if !(u[0].is_finite() && u[1].is_finite()) {
             return Err(config_error("sides", format!("the {} velocity {u:?} is not finite", edge.name())));
         }
-        let s = &mut self.cfg.sides;
-        let side = match edge {
-            Edge::West => &mut s.west,
-            Edge::East => &mut s.east,
-            Edge::South => &mut s.south,
-            Edge::North => &mut s.north,
-        };
-        match side {
+        match self.cfg.sides.get_mut(edge) {
             Side::Velocity { profile } => {
                 profile.fill([u[0] as f32, u[1] as f32]);
                 Ok(())

@@ -32,7 +32,7 @@ pub(crate) fn side_value(c: &KernelCtx, src: &[f32], x: usize, y: usize, k: usiz
     // At a corner a wall wins over an outlet; between two walls the y edge is taken.
     let edge = match (out_x, out_y) {
         (Some(ex), Some(ey)) => {
-            if side(c, ey).is_wall_like() || !side(c, ex).is_wall_like() {
+            if c.sides.get(ey).is_wall_like() || !c.sides.get(ex).is_wall_like() {
                 ey
             } else {
                 ex
@@ -43,7 +43,7 @@ pub(crate) fn side_value(c: &KernelCtx, src: &[f32], x: usize, y: usize, k: usiz
         // source of a fluid node gets a link); bounce back to stay safe.
         (None, None) => return src[c.idx(x, y, OPP[k])],
     };
-    match side(c, edge) {
+    match c.sides.get(edge) {
         Side::Periodic => src[c.idx(x, y, OPP[k])],
         Side::Wall => src[c.idx(x, y, OPP[k])],
         Side::Velocity { profile } => {
@@ -95,15 +95,6 @@ pub(crate) fn side_value(c: &KernelCtx, src: &[f32], x: usize, y: usize, k: usiz
             let shape = 1.0 + cu + 0.5 * cu * cu - 1.5 * (ux * ux + uy * uy);
             g[k] - drho * W[k] * shape
         }
-    }
-}
-
-fn side<'a>(c: &'a KernelCtx, e: Edge) -> &'a Side {
-    match e {
-        Edge::West => &c.sides.west,
-        Edge::East => &c.sides.east,
-        Edge::South => &c.sides.south,
-        Edge::North => &c.sides.north,
     }
 }
 
