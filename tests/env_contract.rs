@@ -171,7 +171,7 @@ fn every_independent_jet_reaches_the_wall_at_the_default_level() {
         }
         let id = spec.id.clone();
         let mut env = LbmEnv::new(spec, Level::Default, None).unwrap_or_else(|e| panic!("{id}: {e}"));
-        let m = env.actuator_mass_sources();
+        let m = env.actuator_mass_sources(1.0);
         println!("{id}: mass per step by each jet at its bound {m:?}");
         for (k, v) in m.iter().enumerate() {
             assert!(*v > 1e-5, "{id}: jet {k} reaches no wall link at the default level ({v:e})");

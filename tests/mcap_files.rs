@@ -119,3 +119,37 @@ fn ctrl_c_during_a_run_leaves_a_valid_trajectory() {
     assert!(steps > 0 && steps < 2000, "{s}");
     assert!(tmp.path().join("Cylinder_2D_Re100-zero-seed0/metrics.json").exists());
 }
+
+/// `hgym train` writes its final evaluation as a trajectory that the Python reader opens: one
+/// episode of 200 actions on the coarse cylinder after one round of TD3 with a small network.
+#[test]
+fn train_final_evaluation_trajectory_reads_back_with_python() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = tmp.path().join("small.toml");
+    std::fs::write(
+        &cfg,
+        "[train]\neval_every = 2\neval_episodes = 1\nfinal_eval_episodes = 1\ncheckpoint_seconds = 1000.0\n\
+         [td3]\nhidden = [32, 32]\nbatch_size = 32\nlearning_starts = 200\n",
+    )
+    .unwrap();
+    let o = hgym(&[
+        "train",
+        "--env",
+        "Cylinder_2D_Re100",
+        "--algo",
+        "td3",
+        "--steps",
+        "400",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--out",
+        tmp.path().to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let file = tmp.path().join("Cylinder_2D_Re100-td3-coarse/seed0/trajectory.mcap");
+    let s = read_with_python(&file).unwrap();
+    assert_eq!(s["counts"]["/reward"], 200, "{s}");
+    assert_eq!(s["counts"]["/obs"], 201, "reset observation + 200: {s}");
+    assert_eq!(s["episodes"], serde_json::json!([0]));
+    assert_eq!(s["env_id"], "Cylinder_2D_Re100");
+}

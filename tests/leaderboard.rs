@@ -1,0 +1,59 @@
+//! `hgym leaderboard` rebuilds the committed leaderboard from the committed results: the same
+//! entries as `results/leaderboard.json`, the markdown table and one bar chart per group.
+
+use std::path::Path;
+use std::process::Command;
+
+/// Copies every `metrics.json` and `manifest.json` below `from` to the same place below `to`
+/// (what the leaderboard reads; trajectories and plots are left behind).
+fn copy_results(from: &Path, to: &Path) {
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        let p = e.path();
+        let q = to.join(e.file_name());
+        if p.is_dir() {
+            copy_results(&p, &q);
+        } else if matches!(p.file_name().and_then(|n| n.to_str()), Some("metrics.json" | "manifest.json")) {
+            std::fs::create_dir_all(to).unwrap();
+            std::fs::copy(&p, &q).unwrap();
+        }
+    }
+}
+
+#[test]
+fn leaderboard_rebuilds_the_committed_one_from_the_committed_results() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    copy_results(&root.join("results"), &results);
+    let o = Command::new(env!("CARGO_BIN_EXE_hgym"))
+        .args(["leaderboard", "--results", results.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let read = |p: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))).unwrap()
+    };
+    let built = read(&results.join("leaderboard.json"));
+    let committed = read(&root.join("results/leaderboard.json"));
+    let entries = built["entries"].as_array().unwrap();
+    assert!(!entries.is_empty());
+    assert_eq!(
+        built, committed,
+        "results/leaderboard.json is not what the committed results give: run `hgym leaderboard`"
+    );
+    let md = std::fs::read_to_string(results.join("LEADERBOARD.md")).unwrap();
+    let pngs = std::fs::read_dir(results.join("leaderboard")).unwrap().count();
+    println!(
+        "{} entries, {} markdown lines, {pngs} bar charts",
+        entries.len(),
+        md.lines().count()
+    );
+    for e in entries {
+        assert!(
+            md.contains(e["env_id"].as_str().unwrap()),
+            "{} missing from LEADERBOARD.md",
+            e["env_id"]
+        );
+    }
+    assert!(pngs >= 1);
+}
