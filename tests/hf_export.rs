@@ -2,21 +2,15 @@
 //! Python `datasets` and pandas load (tests/read_hf.py, in the venv `make setup` builds), with
 //! the same numbers as the MCAP files, flow-field snapshots included.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use common::python;
+
 fn hgym(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_hgym")).args(args).output().expect("run hgym")
-}
-
-fn python() -> PathBuf {
-    if let Some(p) = std::env::var_os("HGYM_PYTHON") {
-        return PathBuf::from(p);
-    }
-    let home = std::env::var_os("HOME").map(PathBuf::from).unwrap_or_default();
-    let p = home.join(".cache/hgym-venv/bin/python");
-    assert!(p.exists(), "{} is missing: run `make setup`", p.display());
-    p
 }
 
 fn ok(o: &Output) -> String {

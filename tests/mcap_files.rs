@@ -2,36 +2,15 @@
 //! reader (installed by `make setup` into ~/.cache/hgym-venv, or `$HGYM_PYTHON`). Ctrl-C leaves a
 //! valid file; `hgym data recover` salvages a truncated one.
 
-use std::path::{Path, PathBuf};
+mod common;
+
 use std::process::{Command, Output, Stdio};
 use std::time::Duration;
 
+use common::read_mcap;
+
 fn hgym(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_hgym")).args(args).output().expect("run hgym")
-}
-
-fn python() -> PathBuf {
-    if let Some(p) = std::env::var_os("HGYM_PYTHON") {
-        return PathBuf::from(p);
-    }
-    let home = std::env::var_os("HOME").map(PathBuf::from).unwrap_or_default();
-    let p = home.join(".cache/hgym-venv/bin/python");
-    assert!(
-        p.exists(),
-        "{} is missing: run `make setup` (installs the Python mcap reader)",
-        p.display()
-    );
-    p
-}
-
-/// The Python reader's summary of a file, or its error text.
-fn read_with_python(file: &Path) -> Result<serde_json::Value, String> {
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/read_mcap.py");
-    let o = Command::new(python()).arg(script).arg(file).output().expect("run python");
-    if !o.status.success() {
-        return Err(String::from_utf8_lossy(&o.stderr).into_owned());
-    }
-    serde_json::from_slice(&o.stdout).map_err(|e| e.to_string())
 }
 
 #[test]
@@ -51,7 +30,7 @@ fn eval_trajectories_read_back_with_python_and_recover_after_truncation() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let file = tmp.path().join("Cylinder_2D_Re100-random-coarse/trajectory.mcap");
-    let s = read_with_python(&file).unwrap();
+    let s = read_mcap(&file).unwrap();
     assert_eq!(s["counts"]["/reward"], 600, "{s}");
     assert_eq!(s["counts"]["/obs"], 603, "reset observation + 200 per episode: {s}");
     assert_eq!(s["episodes"], serde_json::json!([0, 1, 2]));
@@ -69,13 +48,13 @@ fn eval_trajectories_read_back_with_python_and_recover_after_truncation() {
     let bytes = std::fs::read(&file).unwrap();
     let cut = tmp.path().join("cut.mcap");
     std::fs::write(&cut, &bytes[..bytes.len() * 6 / 10]).unwrap();
-    assert!(read_with_python(&cut).map(|s| s["counts"]["/reward"] != 600).unwrap_or(true));
+    assert!(read_mcap(&cut).map(|s| s["counts"]["/reward"] != 600).unwrap_or(true));
     let fixed = tmp.path().join("fixed.mcap");
     let o = hgym(&["data", "recover", cut.to_str().unwrap(), "--out", fixed.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = String::from_utf8_lossy(&o.stdout).into_owned();
     assert!(text.contains("lost"), "recover says what was lost: {text}");
-    let r = read_with_python(&fixed).unwrap();
+    let r = read_mcap(&fixed).unwrap();
     let steps = r["counts"]["/reward"].as_u64().unwrap();
     assert!((200..600).contains(&steps), "whole episodes before the cut survive: {r}");
     // Every episode finished before the cut is whole (a chunk closes at each episode's end);
@@ -114,42 +93,8 @@ fn ctrl_c_during_a_run_leaves_a_valid_trajectory() {
     let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(130), "interrupted runs exit 130");
     let file = tmp.path().join("Cylinder_2D_Re100-zero-seed0/trajectory.mcap");
-    let s = read_with_python(&file).unwrap_or_else(|e| panic!("the interrupted file must be valid: {e}"));
+    let s = read_mcap(&file).unwrap_or_else(|e| panic!("the interrupted file must be valid: {e}"));
     let steps = s["counts"]["/reward"].as_u64().unwrap();
     assert!(steps > 0 && steps < 2000, "{s}");
     assert!(tmp.path().join("Cylinder_2D_Re100-zero-seed0/metrics.json").exists());
-}
-
-/// `hgym train` writes its final evaluation as a trajectory that the Python reader opens: one
-/// episode of 200 actions on the coarse cylinder after one round of TD3 with a small network.
-#[test]
-fn train_final_evaluation_trajectory_reads_back_with_python() {
-    let tmp = tempfile::tempdir().unwrap();
-    let cfg = tmp.path().join("small.toml");
-    std::fs::write(
-        &cfg,
-        "[train]\neval_every = 2\neval_episodes = 1\nfinal_eval_episodes = 1\ncheckpoint_seconds = 1000.0\n\
-         [td3]\nhidden = [32, 32]\nbatch_size = 32\nlearning_starts = 200\n",
-    )
-    .unwrap();
-    let o = hgym(&[
-        "train",
-        "--env",
-        "Cylinder_2D_Re100",
-        "--algo",
-        "td3",
-        "--steps",
-        "400",
-        "--config",
-        cfg.to_str().unwrap(),
-        "--out",
-        tmp.path().to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let file = tmp.path().join("Cylinder_2D_Re100-td3-coarse/seed0/trajectory.mcap");
-    let s = read_with_python(&file).unwrap();
-    assert_eq!(s["counts"]["/reward"], 200, "{s}");
-    assert_eq!(s["counts"]["/obs"], 201, "reset observation + 200: {s}");
-    assert_eq!(s["episodes"], serde_json::json!([0]));
-    assert_eq!(s["env_id"], "Cylinder_2D_Re100");
 }

@@ -1,6 +1,9 @@
 //! `hgym train` / `hgym eval` on a real flow (Cylinder_2D_Re100 at the coarse level, a few
 //! rounds with small networks): result folder, Ctrl-C leaves a checkpoint, `--resume` reaches the
-//! uninterrupted result bitwise, baselines evaluate, size mismatches are refused clearly.
+//! uninterrupted result bitwise, baselines evaluate, size mismatches are refused clearly; the
+//! final evaluation's trajectory opens in the Python `mcap` reader.
+
+mod common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -68,6 +71,12 @@ fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
     let manifest: serde_json::Value = serde_json::from_str(&read(&run.join("manifest.json"))).unwrap();
     assert_eq!(manifest["samples"], 1600);
     assert_eq!(manifest["algo"], "td3");
+    // The final evaluation (one episode of 200 actions) as a trajectory people can open.
+    let s = common::read_mcap(&run.join("trajectory.mcap")).unwrap();
+    assert_eq!(s["counts"]["/reward"], 200, "{s}");
+    assert_eq!(s["counts"]["/obs"], 201, "reset observation + 200: {s}");
+    assert_eq!(s["episodes"], serde_json::json!([0]));
+    assert_eq!(s["env_id"], "Cylinder_2D_Re100");
 
     // Interrupted with SIGINT (Ctrl-C) during the run, then resumed.
     let cut = tmp.path().join("cut");

@@ -1,0 +1,32 @@
+//! Helpers shared by the integration tests that read hgym's files with the Python tools people
+//! use (the venv `make setup` builds in ~/.cache/hgym-venv, or `$HGYM_PYTHON`).
+
+#![allow(dead_code)] // each test binary uses a part
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The Python interpreter with `mcap`, pandas, pyarrow and `datasets` installed.
+pub fn python() -> PathBuf {
+    if let Some(p) = std::env::var_os("HGYM_PYTHON") {
+        return PathBuf::from(p);
+    }
+    let home = std::env::var_os("HOME").map(PathBuf::from).unwrap_or_default();
+    let p = home.join(".cache/hgym-venv/bin/python");
+    assert!(
+        p.exists(),
+        "{} is missing: run `make setup` (installs the Python mcap reader, pandas and datasets)",
+        p.display()
+    );
+    p
+}
+
+/// The Python `mcap` reader's summary of a trajectory (tests/read_mcap.py), or its error text.
+pub fn read_mcap(file: &Path) -> Result<serde_json::Value, String> {
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/read_mcap.py");
+    let o = Command::new(python()).arg(script).arg(file).output().expect("run python");
+    if !o.status.success() {
+        return Err(String::from_utf8_lossy(&o.stderr).into_owned());
+    }
+    serde_json::from_slice(&o.stdout).map_err(|e| e.to_string())
+}
