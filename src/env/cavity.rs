@@ -47,7 +47,7 @@
 //! grid.
 
 use super::actuation::{Jet, Ramp};
-use super::spec::{probe_grid, ActuationSpec, EnvSpec, Normalization, RewardSpec};
+use super::spec::{probe_grid, ActuationSpec, EdgeName, EnvSpec, Normalization, RewardSpec, SpongeSpec};
 use crate::validate::case::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
 
 pub const REYNOLDS: [u32; 2] = [4200, 7500];
@@ -102,7 +102,7 @@ fn base(id: String, family: &str, re: u32, jets: Vec<Jet>, description: String) 
         }],
         domain: DomainSpec {
             x: [0.0, 2.5],
-            y: [0.0, 1.5],
+            y: [0.0, 2.0],
         },
         boundaries: BoundarySpec {
             west: BoundaryKind::Inlet,
@@ -131,6 +131,11 @@ fn base(id: String, family: &str, re: u32, jets: Vec<Jet>, description: String) 
         spin_up: 120.0,
         normalization: Normalization::default(),
         gust: None,
+        sponge: Some(SpongeSpec {
+            edge: EdgeName::North,
+            thickness: 0.5,
+            strength: 0.1,
+        }),
     }
 }
 

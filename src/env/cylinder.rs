@@ -97,6 +97,7 @@ pub(super) fn bluff_body(
         spin_up: 60.0,
         normalization: Normalization::default(),
         gust: None,
+        sponge: None,
     }
 }
 

@@ -16,7 +16,7 @@
 use std::path::PathBuf;
 
 use hgym_agents::{checked_action, BoxSpace, Env, EnvError, Info, StepResult};
-use hgym_solvers::lbm::{D2q9, D2q9Config, Edge, Grid, Units};
+use hgym_solvers::lbm::{D2q9, D2q9Config, Edge, Grid, Sponge, Units};
 
 use super::actuation::{apply, Jet, WallMotion};
 use super::spec::{ActuationSpec, EnvSpec, RewardSpec};
@@ -75,6 +75,15 @@ impl LbmEnv {
         cfg.smagorinsky = spec.smagorinsky;
         cfg.grid = grid;
         cfg.check_interval = 100;
+        if let Some(sp) = &spec.sponge {
+            cfg.sponges.push(Sponge {
+                edge: sp.edge.lattice(),
+                width: ((sp.thickness * n).round() as usize).max(1),
+                strength: sp.strength,
+                rho: 1.0,
+                u: [spec.lattice_velocity, 0.0],
+            });
+        }
         let bodies = spec.bodies.iter().map(build_shape).collect();
         let solver = D2q9::new(cfg, bodies).map_err(backend)?;
         let steps_per_action = units.steps(spec.control_interval).max(1);

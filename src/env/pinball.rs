@@ -106,5 +106,6 @@ pub fn rotary(re: u32) -> EnvSpec {
         spin_up: 150.0,
         normalization: Normalization::default(),
         gust: None,
+        sponge: None,
     }
 }

@@ -113,6 +113,42 @@ pub struct EnvSpec {
     /// A transverse gust entering through the inlet during each episode (none: steady inflow).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gust: Option<GustSpec>,
+    /// An absorbing layer along one edge (the open cavity's top), relaxing to the free stream.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sponge: Option<SpongeSpec>,
+}
+
+/// An edge of the rectangular domain, by compass direction.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(rename_all = "snake_case")]
+pub enum EdgeName {
+    West,
+    East,
+    South,
+    North,
+}
+
+impl EdgeName {
+    pub fn lattice(self) -> hgym_solvers::lbm::Edge {
+        use hgym_solvers::lbm::Edge;
+        match self {
+            EdgeName::West => Edge::West,
+            EdgeName::East => Edge::East,
+            EdgeName::South => Edge::South,
+            EdgeName::North => Edge::North,
+        }
+    }
+}
+
+/// An absorbing layer (see `hgym_solvers::lbm::sponge`): `thickness` in reference lengths,
+/// `strength` the relaxation per lattice step at the edge (the ramp is quadratic), target the
+/// free stream `(rho, u) = (1, U)`.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SpongeSpec {
+    pub edge: EdgeName,
+    pub thickness: f64,
+    pub strength: f64,
 }
 
 /// A "1 - cos" transverse gust imposed at the inflow (the paper's gust-airfoil set-up): the

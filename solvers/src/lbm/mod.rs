@@ -21,10 +21,13 @@ mod kernel;
 pub mod lattice;
 mod probes;
 mod solver;
+pub mod sponge;
+pub mod thermal;
 mod units;
 
 pub use collision::Collision;
 pub use domain::{Edge, Grid, Side, Sides};
 pub use error::LbmError;
 pub use solver::{D2q9, D2q9Config, WallPoint};
+pub use sponge::Sponge;
 pub use units::Units;

@@ -12,6 +12,7 @@ use super::error::LbmError;
 use super::forces::link_forces;
 use super::kernel::{row_fn, KernelCtx, Link, Special};
 use super::lattice::{CX, CY, OPP, Q};
+use super::sponge::{apply_row, Sponge, SpongePlan};
 use crate::geometry::Shape;
 
 /// Everything needed to build a [`D2q9`]. Plain data: threads are whatever rayon pool the step
@@ -40,6 +41,8 @@ pub struct D2q9Config {
     /// Non-temporal stores for the interior: `None` decides by size
     /// ([`STREAM_STORES_ABOVE_BYTES`]). A performance knob only: results are bitwise the same.
     pub stream_stores: Option<bool>,
+    /// Absorbing layers along edges (none by default), see [`super::sponge`].
+    pub sponges: Vec<Sponge>,
 }
 
 impl D2q9Config {
@@ -58,6 +61,7 @@ impl D2q9Config {
             rho_bounds: [0.5, 2.0],
             u_max: 0.5,
             stream_stores: None,
+            sponges: Vec::new(),
         }
     }
 }
@@ -89,6 +93,7 @@ pub struct D2q9 {
     bodies: Vec<Arc<dyn Shape>>,
     body_forces: Vec<[f64; 2]>,
     row_stats: Vec<RowStat>,
+    sponges: Vec<SpongePlan>,
     velocity_scale: f32,
     time: u64,
 }
@@ -216,6 +221,30 @@ impl D2q9 {
                 }
             }
         }
+        for sp in &cfg.sponges {
+            let across = match sp.edge {
+                Edge::West | Edge::East => nx,
+                Edge::South | Edge::North => ny,
+            };
+            if sp.width == 0 || sp.width >= across {
+                return Err(config_error(
+                    "sponges",
+                    format!("the {} layer is {} nodes thick; it must be 1 to {}", sp.edge.name(), sp.width, across - 1),
+                ));
+            }
+            if !(sp.strength > 0.0 && sp.strength <= 1.0) {
+                return Err(config_error(
+                    "sponges",
+                    format!("the {} layer's strength {} must be in (0, 1]", sp.edge.name(), sp.strength),
+                ));
+            }
+            if !(sp.rho.is_finite() && sp.rho > 0.0 && sp.u[0].is_finite() && sp.u[1].is_finite()) {
+                return Err(config_error("sponges", format!("the {} layer's target state is not finite", sp.edge.name())));
+            }
+            if s.get(sp.edge) == &Side::Periodic {
+                return Err(config_error("sponges", format!("the {} edge is periodic; a layer needs an open or closed edge", sp.edge.name())));
+            }
+        }
         let periodic_x = s.west == Side::Periodic;
         let periodic_y = s.south == Side::Periodic;
         let grid = cfg.grid;
@@ -327,6 +356,7 @@ impl D2q9 {
             bodies,
             body_forces: vec![[0.0; 2]; n_bodies],
             row_stats: vec![RowStat::default(); ny],
+            sponges: cfg.sponges.iter().map(SpongePlan::new).collect(),
             velocity_scale: 1.0,
             time: 0,
             cfg,
@@ -373,7 +403,11 @@ impl D2q9 {
         let forced = self.cfg.body_force != [0.0, 0.0];
         let rows = self.f_next.par_chunks_mut(row_len).enumerate().with_min_len(4);
         let kernel = row_fn(self.cfg.collision, forced, self.cfg.smagorinsky > 0.0, false);
-        rows.for_each(|(y, row)| kernel(&ctx, src, row, y));
+        let (nx, ny, sponges, solid) = (self.cfg.nx, self.cfg.ny, &self.sponges, &self.solid);
+        rows.for_each(|(y, row)| {
+            kernel(&ctx, src, row, y);
+            apply_row(sponges, row, y, nx, ny, solid);
+        });
         link_forces(&ctx, src, &mut self.body_forces);
         std::mem::swap(&mut self.f, &mut self.f_next);
         self.time += 1;
@@ -617,6 +651,7 @@ impl D2q9 {
         let kernel = row_fn(self.cfg.collision, forced, self.cfg.smagorinsky > 0.0, true);
         for (y, row) in self.f_next.chunks_mut(row_len).enumerate() {
             kernel(&ctx, &self.f, row, y);
+            apply_row(&self.sponges, row, y, self.cfg.nx, self.cfg.ny, &self.solid);
         }
         link_forces(&ctx, &self.f, &mut self.body_forces);
         std::mem::swap(&mut self.f, &mut self.f_next);
