@@ -66,7 +66,10 @@ fn a_top_sponge_absorbs_the_standing_acoustic_wave_viscosity_alone_keeps() {
     // Viscous damping of the mode at nu = 0.0067: exp(-nu k^2 t) ~ 0.98 in amplitude, so the
     // energy stays within a factor ~2 (it also sloshes between density and velocity).
     assert!(e_open > 0.3, "without a layer the wave should survive, energy ratio {e_open}");
-    assert!(e_damped < 0.01 * e_open, "the layer left {e_damped} of the energy, against {e_open} without it");
+    assert!(
+        e_damped < 0.01 * e_open,
+        "the layer left {e_damped} of the energy, against {e_open} without it"
+    );
 }
 
 #[test]
@@ -86,7 +89,12 @@ fn a_flow_at_the_target_state_is_left_exactly_alone() {
     s.init_with(|_, _| (1.0, 0.05, 0.0));
     let before = s.populations().to_vec();
     s.advance(50).unwrap();
-    let drift = s.populations().iter().zip(&before).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+    let drift = s
+        .populations()
+        .iter()
+        .zip(&before)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f32, f32::max);
     assert!(drift < 1e-6, "uniform flow at the target state drifted by {drift}");
 }
 
@@ -119,7 +127,10 @@ fn the_fast_kernel_applies_layers_as_the_oracle_does() {
         fast.step().unwrap();
         slow.step_reference().unwrap();
     }
-    assert!(fast.populations() == slow.populations(), "fast and reference steps differ with sponges");
+    assert!(
+        fast.populations() == slow.populations(),
+        "fast and reference steps differ with sponges"
+    );
 }
 
 #[test]

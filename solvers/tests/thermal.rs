@@ -65,7 +65,10 @@ fn advection_conserves_heat_and_moves_the_blob_at_the_flow_speed() {
     }
     let (cx, cy) = (mx / t.total(), my / t.total());
     let (ex, ey) = (x0 + ux as f64 * steps as f64, y0 + uy as f64 * steps as f64);
-    assert!((cx - ex).abs() < 0.05 && (cy - ey).abs() < 0.05, "centroid ({cx:.3}, {cy:.3}), expected ({ex}, {ey})");
+    assert!(
+        (cx - ex).abs() < 0.05 && (cy - ey).abs() < 0.05,
+        "centroid ({cx:.3}, {cy:.3}), expected ({ex}, {ey})"
+    );
 }
 
 #[test]
@@ -113,9 +116,16 @@ fn the_inlet_temperature_can_be_changed_and_bad_settings_are_refused() {
     let sides = [ThermalSide::Temperature(0.9), ThermalSide::ZeroGradient, P, P];
     let mut t = Thermal::new(8, 4, 0.7, sides, vec![false; 32], 1.0).unwrap();
     t.set_side_temperature(Edge::West, 0.95).unwrap();
-    assert!(t.set_side_temperature(Edge::East, 0.95).unwrap_err().to_string().contains("not a fixed-temperature"));
+    assert!(t
+        .set_side_temperature(Edge::East, 0.95)
+        .unwrap_err()
+        .to_string()
+        .contains("not a fixed-temperature"));
     assert!(t.set_side_temperature(Edge::West, f64::NAN).is_err());
-    assert!(Thermal::new(8, 4, 0.5, sides, vec![false; 32], 1.0).unwrap_err().to_string().contains("1/2"));
+    assert!(Thermal::new(8, 4, 0.5, sides, vec![false; 32], 1.0)
+        .unwrap_err()
+        .to_string()
+        .contains("1/2"));
     let mixed = [P, ThermalSide::ZeroGradient, P, P];
     assert!(Thermal::new(8, 4, 0.7, mixed, vec![false; 32], 1.0).is_err());
 }

@@ -43,6 +43,7 @@ impl AnySpec {
 
     pub fn solver(&self) -> &'static str {
         match self {
+            AnySpec::Lbm(s) if s.thermal.is_some() => "lbm-d2q9+q5",
             AnySpec::Lbm(_) => "lbm-d2q9",
             AnySpec::Kolmogorov(_) => "spectral",
         }

@@ -98,6 +98,8 @@ pub(super) fn bluff_body(
         normalization: Normalization::default(),
         gust: None,
         sponge: None,
+        thermal: None,
+        inflow: None,
     }
 }
 

@@ -12,11 +12,16 @@
 //!   `C_D_b`, `C_L_b`), with `t` and the physical actuation `actuation_k` (units of U or U/D).
 //!   A solver blow-up ends the episode with `terminated = true`, `info["diverged"] = 1` and the
 //!   reason in `info.text["reason"]`.
+//! - A spec with `thermal` also carries a temperature field (D2Q5, stepped after every flow step
+//!   with the flow's velocity), observed as a fourth value per probe and cached with the flow;
+//!   with `inflow` the west velocity oscillates (its phase continues from the spin-up, so the
+//!   seed-dependent start also picks the phase of the oscillation).
 
 use std::path::PathBuf;
 
 use hgym_agents::{checked_action, BoxSpace, Env, EnvError, Info, StepResult};
-use hgym_solvers::lbm::{D2q9, D2q9Config, Edge, Grid, Sponge, Units};
+use hgym_solvers::lbm::thermal::{Thermal, ThermalSide};
+use hgym_solvers::lbm::{D2q9, D2q9Config, Edge, Grid, LbmError, Side, Sponge, Units};
 
 use super::actuation::{apply, Jet, WallMotion};
 use super::spec::{ActuationSpec, EnvSpec, RewardSpec};
@@ -45,6 +50,21 @@ pub struct LbmEnv {
     attractor: Option<Vec<f32>>,
     cache_dir: Option<PathBuf>,
     t0: u64,
+    /// The temperature field, with the velocity buffers it is stepped with.
+    thermal: Option<Thermal>,
+    fields: [Vec<f32>; 3],
+    /// Seed of the inflow noise (0 during the spin-up, the episode's seed after a reset).
+    noise_seed: u64,
+}
+
+/// A standard normal number for interval `k` of a run seeded `seed` (Box-Muller on two
+/// splitmix64 draws): stateless, so any interval's value is known without replaying the others.
+fn gaussian(seed: u64, k: u64) -> f64 {
+    let a = splitmix64(seed ^ splitmix64(k));
+    let b = splitmix64(a);
+    let u1 = ((a >> 11) as f64 + 0.5) / (1u64 << 53) as f64;
+    let u2 = (b >> 11) as f64 / (1u64 << 53) as f64;
+    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
 
 fn backend(e: impl std::fmt::Display) -> EnvError {
@@ -69,7 +89,18 @@ impl LbmEnv {
             dx,
         };
         let u = spec.lattice_velocity as f32;
-        let sides = sides_of(&spec.boundaries, &vec![[u, 0.0]; ny]);
+        let inlet: Vec<[f32; 2]> = if spec.inflow.is_some() {
+            // Poiseuille profile of mean U across the channel (the domain's height).
+            (0..ny)
+                .map(|j| {
+                    let eta = (j as f64 + 0.5) / ny as f64;
+                    [(6.0 * eta * (1.0 - eta)) as f32 * u, 0.0]
+                })
+                .collect()
+        } else {
+            vec![[u, 0.0]; ny]
+        };
+        let sides = sides_of(&spec.boundaries, &inlet);
         let mut cfg = D2q9Config::new(nx, ny, units.tau(), sides);
         cfg.collision = spec.collision;
         cfg.smagorinsky = spec.smagorinsky;
@@ -86,6 +117,37 @@ impl LbmEnv {
         }
         let bodies = spec.bodies.iter().map(build_shape).collect();
         let solver = D2q9::new(cfg, bodies).map_err(backend)?;
+        let thermal = match &spec.thermal {
+            None => None,
+            Some(th) => {
+                let side = |s: &Side, edge: Edge| match (s, edge) {
+                    (Side::Periodic, _) => ThermalSide::Periodic,
+                    (Side::Outlet, _) => ThermalSide::ZeroGradient,
+                    (_, Edge::West) => ThermalSide::Temperature(th.inlet_temperature as f32),
+                    _ => ThermalSide::Temperature(th.wall_temperature as f32),
+                };
+                let s = &solver.config().sides;
+                let sides = [
+                    side(&s.west, Edge::West),
+                    side(&s.east, Edge::East),
+                    side(&s.south, Edge::South),
+                    side(&s.north, Edge::North),
+                ];
+                let solid = (0..ny)
+                    .flat_map(|y| (0..nx).map(move |x| (x, y)))
+                    .map(|(x, y)| solver.is_solid(x, y))
+                    .collect();
+                let tau = 0.5 + 3.0 * units.nu() / th.prandtl;
+                let mut t = Thermal::new(nx, ny, tau, sides, solid, th.wall_temperature).map_err(backend)?;
+                t.init_with(|_, _| th.initial_temperature);
+                Some(t)
+            }
+        };
+        let fields = if thermal.is_some() {
+            [vec![0.0; nx * ny], vec![0.0; nx * ny], vec![0.0; nx * ny]]
+        } else {
+            Default::default()
+        };
         let steps_per_action = units.steps(spec.control_interval).max(1);
         let circle = |i: usize| match spec.bodies.get(i) {
             Some(GeometrySpec::Circle { center, diameter }) => Ok((*center, 0.5 * diameter)),
@@ -121,6 +183,13 @@ impl LbmEnv {
                 (jets.clone(), vec![])
             }
             ActuationSpec::Rotation { bodies, .. } => (vec![], bodies.iter().map(|&i| circle(i).map(|c| c.0)).collect::<Result<_, _>>()?),
+            ActuationSpec::InletTemperature { .. } if thermal.is_none() => {
+                return Err(EnvError::Backend(format!(
+                    "{}: an inlet-temperature actuator needs a [thermal] section",
+                    spec.id
+                )));
+            }
+            ActuationSpec::InletTemperature { .. } => (vec![], vec![]),
         };
         let act_dim = spec.act_dim();
         Ok(LbmEnv {
@@ -137,6 +206,9 @@ impl LbmEnv {
             attractor: None,
             cache_dir,
             t0: 0,
+            thermal,
+            fields,
+            noise_seed: 0,
         })
     }
 
@@ -200,6 +272,55 @@ impl LbmEnv {
             };
             apply(&mut self.solver, b, &motion, &self.units);
         }
+        if let (ActuationSpec::InletTemperature { .. }, Some(th)) = (&self.spec.actuation, &mut self.thermal) {
+            // Finite and within the spec's range by construction (see `step`).
+            let _ = th.set_side_temperature(Edge::West, a[0]);
+        }
+    }
+
+    /// One lattice step of everything the spec has: the oscillatory inflow's scale, the flow,
+    /// and the temperature carried by it. Without those, exactly `D2q9::step`.
+    fn substep(&mut self) -> Result<(), LbmError> {
+        if let Some(inflow) = &self.spec.inflow {
+            let t = self.solver.time() as f64 * self.units.time_per_step();
+            let k = (t / self.spec.control_interval).floor().max(0.0) as u64;
+            let omega = inflow.omega(self.spec.reynolds);
+            let scale = (omega * t).sin() + inflow.noise * gaussian(self.noise_seed, k);
+            self.solver.set_boundary_velocity_scale(scale);
+        }
+        self.solver.step()?;
+        if let Some(th) = &mut self.thermal {
+            let [rho, ux, uy] = &mut self.fields;
+            self.solver.macroscopic(rho, ux, uy);
+            th.step(ux, uy);
+        }
+        Ok(())
+    }
+
+    fn advance(&mut self, n: u64) -> Result<(), LbmError> {
+        if self.thermal.is_none() && self.spec.inflow.is_none() {
+            return self.solver.advance(n);
+        }
+        for _ in 0..n {
+            self.substep()?;
+        }
+        Ok(())
+    }
+
+    /// Temperature (units of T_wall) at a physical point, bilinear.
+    fn temperature_at(&self, p: [f64; 2]) -> Option<f64> {
+        let th = self.thermal.as_ref()?;
+        let g = self.solver.config().grid;
+        let t_wall = self.spec.thermal.as_ref().map_or(1.0, |s| s.wall_temperature);
+        Some(th.sample((p[0] - g.origin[0]) / g.dx, (p[1] - g.origin[1]) / g.dx) / t_wall)
+    }
+
+    /// The actuation with the actuators at rest: zero, or the starting inlet temperature.
+    fn rest_actuation(&self) -> Vec<f64> {
+        match (&self.spec.actuation, &self.spec.thermal) {
+            (ActuationSpec::InletTemperature { .. }, Some(th)) => vec![th.inlet_temperature],
+            _ => vec![0.0; self.spec.act_dim()],
+        }
     }
 
     fn bound(&self) -> f64 {
@@ -208,6 +329,7 @@ impl LbmEnv {
             | ActuationSpec::ZnmfJetsPerBody { max_velocity, .. }
             | ActuationSpec::Jets { max_velocity, .. } => *max_velocity,
             ActuationSpec::Rotation { max_omega, .. } => *max_omega,
+            ActuationSpec::InletTemperature { max_change, .. } => *max_change,
         }
     }
 
@@ -243,7 +365,7 @@ impl LbmEnv {
         if let Some(a) = &self.attractor {
             return Ok(a.clone());
         }
-        let want = self.solver.populations().len();
+        let want = self.solver.populations().len() + self.thermal.as_ref().map_or(0, |t| t.populations().len());
         if let Some(path) = self.cache_file() {
             if let Ok(bytes) = std::fs::read(&path) {
                 if bytes.len() == 4 * want {
@@ -271,12 +393,16 @@ impl LbmEnv {
             let r2 = (x - c[0] - 1.0).powi(2) + (y - c[1] - 0.25).powi(2);
             (1.0, u, 0.3 * u * (-4.0 * r2).exp())
         });
-        self.actuate(&vec![0.0; self.spec.act_dim()]);
+        let rest = self.rest_actuation();
+        self.actuate(&rest);
+        self.noise_seed = 0;
         let steps = self.units.steps(self.spec.spin_up);
-        self.solver
-            .advance(steps)
+        self.advance(steps)
             .map_err(|e| EnvError::Backend(format!("{}: spin-up diverged: {e}", self.spec.id)))?;
-        let state = self.solver.populations().to_vec();
+        let mut state = self.solver.populations().to_vec();
+        if let Some(th) = &self.thermal {
+            state.extend_from_slice(th.populations());
+        }
         if let Some(path) = self.cache_file() {
             if let Some(dir) = path.parent() {
                 let _ = std::fs::create_dir_all(dir);
@@ -318,6 +444,9 @@ impl LbmEnv {
             obs.push(self.units.velocity(ux));
             obs.push(self.units.velocity(uy));
             obs.push(self.units.pressure(rho));
+            if let Some(t) = self.temperature_at(*p) {
+                obs.push(t);
+            }
         }
         Ok(obs)
     }
@@ -366,13 +495,24 @@ impl Env for LbmEnv {
 
     fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
         let state = self.attractor()?;
-        self.solver.set_populations(&state, 0).map_err(backend)?;
-        self.a_old = vec![0.0; self.spec.act_dim()];
-        let zero = self.a_old.clone();
-        self.actuate(&zero);
+        let n_flow = self.solver.populations().len();
+        // An oscillating inflow continues its phase from the end of the spin-up.
+        let time = if self.spec.inflow.is_some() {
+            self.units.steps(self.spec.spin_up)
+        } else {
+            0
+        };
+        self.solver.set_populations(&state[..n_flow], time).map_err(backend)?;
+        if let Some(th) = &mut self.thermal {
+            th.set_populations(&state[n_flow..]).map_err(backend)?;
+        }
+        self.noise_seed = seed;
+        self.a_old = self.rest_actuation();
+        let rest = self.a_old.clone();
+        self.actuate(&rest);
         self.set_gust(0.0)?;
         let offset = (splitmix64(seed) % 64) * (self.steps_per_action / 2).max(1);
-        self.solver.advance(offset).map_err(backend)?;
+        self.advance(offset).map_err(backend)?;
         self.t0 = self.solver.time();
         self.actions_taken = 0;
         self.live = true;
@@ -388,7 +528,13 @@ impl Env for LbmEnv {
         }
         let (a, clipped) = checked_action(&self.action_space(), action)?;
         let bound = self.bound();
-        let a_new: Vec<f64> = a.iter().map(|v| v * bound).collect();
+        let a_new: Vec<f64> = match &self.spec.actuation {
+            // The action is a change of the inlet temperature.
+            ActuationSpec::InletTemperature { range, .. } => {
+                vec![(self.a_old[0] + a[0] * bound).clamp(range[0], range[1])]
+            }
+            _ => a.iter().map(|v| v * bound).collect(),
+        };
         let n_bodies = self.spec.bodies.len();
         let mut cd = vec![0.0; n_bodies];
         let mut cl = vec![0.0; n_bodies];
@@ -403,7 +549,7 @@ impl Env for LbmEnv {
             }
             self.actuate(&now);
             self.set_gust(self.time())?;
-            if let Err(e) = self.solver.step() {
+            if let Err(e) = self.substep() {
                 diverged = Some(e.to_string());
                 break;
             }
@@ -426,6 +572,10 @@ impl Env for LbmEnv {
         }
         info.set("C_D", cd.iter().sum());
         info.set("C_L", cl.iter().sum());
+        if let RewardSpec::ProbeTemperature { probe, .. } = &self.spec.reward {
+            let t = self.spec.probes.get(*probe).and_then(|p| self.temperature_at(*p));
+            info.set("T_target", t.unwrap_or(f64::NAN));
+        }
         if let Some(reason) = diverged {
             self.live = false;
             info.set("diverged", 1.0);
@@ -474,6 +624,7 @@ pub fn reward(spec: &RewardSpec, info: &Info, obs: &[f64], n_bodies: usize) -> f
             -c_d.abs() - lift_weight * c_l.abs()
         }
         RewardSpec::ProbeDeviation => -9.0 * obs.iter().map(|o| o * o).sum::<f64>(),
+        RewardSpec::ProbeTemperature { target, weight, .. } => -weight * (info.get("T_target").unwrap_or(f64::NAN) - target).abs(),
         RewardSpec::GustLoads {
             c_l_ref,
             c_d_ref,

@@ -1,8 +1,8 @@
 //! Flow environments: where solvers (`hgym-solvers`) meet the `Env` contract (`hgym-agents`).
 //!
 //! - [`spec`]: the serialisable description of an environment (its hash keys caches and results);
-//! - [`registry`]: every ID; [`cylinder`], [`pinball`], [`square`], [`cavity`], [`naca`]: the
-//!   families' specs;
+//! - [`registry`]: every ID; [`cylinder`], [`pinball`], [`square`], [`cavity`], [`naca`],
+//!   [`pipe`]: the families' specs;
 //! - [`lbm_env`]: the `Env` implementation for 2D lattice-Boltzmann families;
 //! - [`actuation`]: jets, rotation, and the temporal smoothing of actions.
 
@@ -16,6 +16,7 @@ pub mod kolmogorov;
 pub mod lbm_env;
 pub mod naca;
 pub mod pinball;
+pub mod pipe;
 pub mod registry;
 pub mod rollout;
 pub mod spec;

@@ -107,5 +107,7 @@ pub fn rotary(re: u32) -> EnvSpec {
         normalization: Normalization::default(),
         gust: None,
         sponge: None,
+        thermal: None,
+        inflow: None,
     }
 }

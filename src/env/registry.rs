@@ -1,9 +1,11 @@
 //! Every environment ID and its spec.
 
 use super::calibrate;
+use super::cavity;
 use super::cylinder;
 use super::naca;
 use super::pinball;
+use super::pipe;
 use super::spec::EnvSpec;
 use super::square;
 
@@ -25,7 +27,7 @@ pub fn all() -> Vec<EnvSpec> {
     for re in square::REYNOLDS {
         v.push(square::square(re));
     }
-    // The open cavity (`cavity::specs()`) is not registered yet: see the module's docs.
+    v.extend(cavity::specs());
     for re in naca::REYNOLDS {
         for aoa in naca::ANGLES {
             v.push(naca::steady(re, aoa));
@@ -35,6 +37,9 @@ pub fn all() -> Vec<EnvSpec> {
         for aoa in naca::ANGLES {
             v.extend(naca::gust(re, aoa));
         }
+    }
+    for re in pipe::REYNOLDS {
+        v.push(pipe::stenotic_pipe(re));
     }
     // The table is checked by a test; a broken one only means uncalibrated observations.
     let table = calibrate::parse_table(calibrate::TABLE).unwrap_or_default();

@@ -40,6 +40,9 @@ pub enum ActuationSpec {
     /// Surface rotation of the listed circular bodies, one action each.
     /// Bound: `max_omega` in units of U/D.
     Rotation { bodies: Vec<usize>, max_omega: f64 },
+    /// The inlet temperature (needs `thermal`): each action changes it by at most `max_change`
+    /// (units of T_wall), kept within `range`; it starts at `thermal.inlet_temperature`.
+    InletTemperature { max_change: f64, range: [f64; 2] },
 }
 
 impl ActuationSpec {
@@ -49,6 +52,7 @@ impl ActuationSpec {
             ActuationSpec::Jets { jets, .. } => jets.len(),
             ActuationSpec::ZnmfJetsPerBody { bodies, .. } => bodies.len(),
             ActuationSpec::Rotation { bodies, .. } => bodies.len(),
+            ActuationSpec::InletTemperature { .. } => 1,
         }
     }
 }
@@ -69,6 +73,8 @@ pub enum RewardSpec {
     /// `r = -|C_L - c_l_ref| - w |C_D - c_d_ref|` (the paper's gust mitigation): force deviation
     /// from the time-averaged coefficients of the undisturbed flow, with `w = drag_weight`.
     GustLoads { c_l_ref: f64, c_d_ref: f64, drag_weight: f64 },
+    /// `-weight |T(probe) / T_wall - target|` (the stenotic pipe; `T_target` in info).
+    ProbeTemperature { probe: usize, target: f64, weight: f64 },
 }
 
 /// Observation normalisation `obs = (raw - mean) / scale`, computed by `hgym envs calibrate`
@@ -115,7 +121,45 @@ pub struct EnvSpec {
     pub gust: Option<GustSpec>,
     /// An absorbing layer along one edge (the open cavity's top), relaxing to the free stream.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sponge: Option<SpongeSpec>,
+    pub sponge: Option<Box<SpongeSpec>>,
+    /// Temperature carried by the flow (observed as a fourth value per probe).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thermal: Option<Box<ThermalSpec>>,
+    /// Oscillatory inflow instead of a steady one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inflow: Option<Box<InflowSpec>>,
+}
+
+/// A passive temperature field (D2Q5, `hgym_solvers::lbm::thermal`): diffusivity `nu / Pr`;
+/// temperatures in units of the wall temperature, which bodies and the north and south sides
+/// hold; the west side holds the inlet temperature (the actuator), the east side is open.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ThermalSpec {
+    pub prandtl: f64,
+    pub wall_temperature: f64,
+    /// The inlet temperature at the start of every episode (and during the spin-up).
+    pub inlet_temperature: f64,
+    /// The fluid's temperature when the spin-up starts.
+    pub initial_temperature: f64,
+}
+
+/// Oscillatory inflow through the west side: a Poiseuille profile of mean velocity `U s(t)`,
+/// `s(t) = sin(omega t) + noise xi_k`, with `omega` from the Womersley number
+/// `alpha = (D / 2) sqrt(omega / nu)`, i.e. `omega = 4 alpha^2 / Re` in units of U / D, and
+/// `xi_k` a standard normal number drawn once per control interval `k` from the episode's seed.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct InflowSpec {
+    pub womersley: f64,
+    pub noise: f64,
+}
+
+impl InflowSpec {
+    /// Angular frequency in units of U / D at Reynolds number `re`.
+    pub fn omega(&self, re: f64) -> f64 {
+        4.0 * self.womersley * self.womersley / re
+    }
 }
 
 /// An edge of the rectangular domain, by compass direction.
@@ -182,8 +226,9 @@ impl EnvSpec {
         format!("{:x}", Sha256::digest(json.as_bytes()))
     }
 
+    /// `(u, v, p)` per probe, and `T` with a temperature field.
     pub fn obs_dim(&self) -> usize {
-        3 * self.probes.len()
+        (3 + usize::from(self.thermal.is_some())) * self.probes.len()
     }
 
     pub fn act_dim(&self) -> usize {

@@ -98,6 +98,14 @@ pub enum GeometrySpec {
         length: f64,
         depth: f64,
     },
+    /// A cosine constriction of a straight channel (the domain's walls) with its throat at
+    /// `center`; reference length: the channel width.
+    Stenosis {
+        center: [f64; 2],
+        width: f64,
+        length: f64,
+        severity: f64,
+    },
 }
 
 impl GeometrySpec {
@@ -107,15 +115,18 @@ impl GeometrySpec {
             GeometrySpec::Square { side, .. } => *side,
             GeometrySpec::Naca { chord, .. } => *chord,
             GeometrySpec::Cavity { depth, .. } => *depth,
+            GeometrySpec::Stenosis { width, .. } => *width,
         }
     }
 
     /// Whether fluid at `p` starts at rest when a flow is spun up from the uniform stream: below
     /// a cavity's lips (an impulsive start with U inside the cavity sheds vortices that the thin
-    /// layer above it keeps for tens of time units); nowhere for the other shapes.
+    /// layer above it keeps for tens of time units); everywhere in a stenosed channel (its
+    /// oscillatory inflow starts from zero); nowhere for the other shapes.
     pub fn starts_at_rest(&self, p: [f64; 2]) -> bool {
         match self {
             GeometrySpec::Cavity { leading_edge, .. } => p[1] < leading_edge[1],
+            GeometrySpec::Stenosis { .. } => true,
             _ => false,
         }
     }
@@ -123,7 +134,7 @@ impl GeometrySpec {
     /// A point at the body's centre (for the initial perturbation).
     pub fn center(&self) -> [f64; 2] {
         match self {
-            GeometrySpec::Circle { center, .. } | GeometrySpec::Square { center, .. } => *center,
+            GeometrySpec::Circle { center, .. } | GeometrySpec::Square { center, .. } | GeometrySpec::Stenosis { center, .. } => *center,
             GeometrySpec::Naca { chord, leading_edge, .. } => [leading_edge[0] + 0.5 * chord, leading_edge[1]],
             GeometrySpec::Cavity {
                 leading_edge,

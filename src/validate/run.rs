@@ -4,7 +4,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use hgym_solvers::geometry::{Circle, Naca4, OpenCavity, Rectangle, Shape};
+use hgym_solvers::geometry::{Circle, Naca4, OpenCavity, Rectangle, Shape, Stenosis};
 use hgym_solvers::lbm::{Collision, D2q9, D2q9Config, Grid, LbmError, Side, Sides, Units};
 
 use super::case::{BoundaryKind, BoundarySpec, GeometrySpec, Level, LoadedCase, Profile, MAX_NODES};
@@ -41,6 +41,17 @@ pub fn build_shape(g: &GeometrySpec) -> Arc<dyn Shape> {
             leading_edge: *leading_edge,
             length: *length,
             depth: *depth,
+        }),
+        GeometrySpec::Stenosis {
+            center,
+            width,
+            length,
+            severity,
+        } => Arc::new(Stenosis {
+            center: *center,
+            width: *width,
+            length: *length,
+            severity: *severity,
         }),
     }
 }

@@ -4,20 +4,22 @@
 //! `phi(p)`: negative inside the body, positive in the fluid, zero on the wall. Everything the
 //! lattice needs (which nodes are solid, where a lattice link crosses the wall, the wall normal)
 //! follows from `phi`, so a new shape only has to say how far a point is from it. Circles,
-//! rectangles (square cylinders), NACA 4-digit aerofoils, half-planes (channel walls) and open
-//! cavities are here.
+//! rectangles (square cylinders), NACA 4-digit aerofoils, half-planes (channel walls), open
+//! cavities and channel stenoses are here.
 
 mod cavity;
 mod circle;
 mod naca;
 mod plane;
 mod rectangle;
+mod stenosis;
 
 pub use cavity::OpenCavity;
 pub use circle::Circle;
 pub use naca::Naca4;
 pub use plane::HalfPlane;
 pub use rectangle::Rectangle;
+pub use stenosis::Stenosis;
 
 /// A closed body described by a signed distance function (negative inside).
 pub trait Shape: Send + Sync + std::fmt::Debug {

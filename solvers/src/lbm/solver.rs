@@ -229,7 +229,12 @@ impl D2q9 {
             if sp.width == 0 || sp.width >= across {
                 return Err(config_error(
                     "sponges",
-                    format!("the {} layer is {} nodes thick; it must be 1 to {}", sp.edge.name(), sp.width, across - 1),
+                    format!(
+                        "the {} layer is {} nodes thick; it must be 1 to {}",
+                        sp.edge.name(),
+                        sp.width,
+                        across - 1
+                    ),
                 ));
             }
             if !(sp.strength > 0.0 && sp.strength <= 1.0) {
@@ -239,10 +244,16 @@ impl D2q9 {
                 ));
             }
             if !(sp.rho.is_finite() && sp.rho > 0.0 && sp.u[0].is_finite() && sp.u[1].is_finite()) {
-                return Err(config_error("sponges", format!("the {} layer's target state is not finite", sp.edge.name())));
+                return Err(config_error(
+                    "sponges",
+                    format!("the {} layer's target state is not finite", sp.edge.name()),
+                ));
             }
             if s.get(sp.edge) == &Side::Periodic {
-                return Err(config_error("sponges", format!("the {} edge is periodic; a layer needs an open or closed edge", sp.edge.name())));
+                return Err(config_error(
+                    "sponges",
+                    format!("the {} edge is periodic; a layer needs an open or closed edge", sp.edge.name()),
+                ));
             }
         }
         let periodic_x = s.west == Side::Periodic;

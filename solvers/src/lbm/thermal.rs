@@ -73,14 +73,7 @@ fn config_error(field: &'static str, message: String) -> LbmError {
 impl Thermal {
     /// `solid`: the flow's solid nodes (row-major, `nx * ny`), held at `wall_temperature`;
     /// `tau`: relaxation time (`kappa = (tau - 1/2) / 3`); `sides`: west, east, south, north.
-    pub fn new(
-        nx: usize,
-        ny: usize,
-        tau: f64,
-        sides: [ThermalSide; 4],
-        solid: Vec<bool>,
-        wall_temperature: f64,
-    ) -> Result<Self, LbmError> {
+    pub fn new(nx: usize, ny: usize, tau: f64, sides: [ThermalSide; 4], solid: Vec<bool>, wall_temperature: f64) -> Result<Self, LbmError> {
         if nx < 2 || ny < 2 || solid.len() != nx * ny {
             return Err(config_error(
                 "size",
@@ -120,8 +113,8 @@ impl Thermal {
             for x in 0..self.nx {
                 let c = y * self.nx + x;
                 let t = if self.solid[c] { 0.0 } else { temperature(x, y) as f32 };
-                for i in 0..Q5 {
-                    self.g[i * n + c] = W5[i] * t;
+                for (i, w) in W5.iter().enumerate() {
+                    self.g[i * n + c] = w * t;
                 }
             }
         }
@@ -208,6 +201,21 @@ impl Thermal {
         }
         let n = self.nx * self.ny;
         (0..Q5).map(|i| self.g[i * n + c]).sum()
+    }
+
+    /// Bilinear interpolation of the temperature at lattice coordinates `(xi, eta)` (node
+    /// `(i, j)` at `(i, j)`), clamped to the grid.
+    pub fn sample(&self, xi: f64, eta: f64) -> f64 {
+        let xi = xi.clamp(0.0, (self.nx - 1) as f64);
+        let eta = eta.clamp(0.0, (self.ny - 1) as f64);
+        let x0 = (xi.floor() as usize).min(self.nx - 2);
+        let y0 = (eta.floor() as usize).min(self.ny - 2);
+        let (tx, ty) = (xi - x0 as f64, eta - y0 as f64);
+        let t = |x: usize, y: usize| self.temperature(x, y) as f64;
+        (1.0 - tx) * (1.0 - ty) * t(x0, y0)
+            + tx * (1.0 - ty) * t(x0 + 1, y0)
+            + (1.0 - tx) * ty * t(x0, y0 + 1)
+            + tx * ty * t(x0 + 1, y0 + 1)
     }
 
     /// Sum of the temperature over fluid nodes (the conserved "heat" of a closed domain).

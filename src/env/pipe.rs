@@ -1,0 +1,110 @@
+//! Stenotic pipe (HydroGym "Flow through a stenotic pipe"), 2D: `StenoticPipe_2D_Re100`.
+//!
+//! A straight channel of width D (the reference length) from `x = -4` to `x = 12` (the paper's
+//! 16 D x D) between walls held at the wall temperature `T_wall = 1`, with a cosine stenosis
+//! at `x = 0` that halves the width at its throat over a length 2 D (Varghese, Frankel & Fischer
+//! 2007's profile, `s0 = 0.25`, used as a channel's half-width). Re = U D / nu = 100 with U the
+//! amplitude of the mean inflow velocity.
+//!
+//! Flow: oscillatory (zero-mean) through the west side, a Poiseuille profile scaled by
+//! `sin(omega t) + 0.05 xi_k` with Womersley number `alpha = (D/2) sqrt(omega / nu) = 4`, so
+//! `omega = 4 alpha^2 / Re = 0.64 U/D` (period 9.8 D/U), and the paper's Gaussian noise of
+//! amplitude 0.05 (`xi_k` standard normal, one value per control interval, from the episode's
+//! seed). East: open outlet at the reference pressure. The fluid starts at rest (the
+//! oscillation starts from zero).
+//!
+//! Temperature: a passive scalar (D2Q5, `Pr = 0.71`, air), walls and stenosis at `T_wall`, the
+//! inlet at `T_inlet` (the actuator), zero gradient at the outlet; the fluid starts at 0.9.
+//!
+//! Control, as the paper's: the action changes the inlet temperature by at most
+//! `|Delta T_inlet / T_wall| <= 0.05` per action, from `T_inlet / T_wall = 0.9` at every reset;
+//! we keep it within [0.5, 1.5]. Observations: `(u, v, p, T)` at 10 centreline probes from
+//! `x = -3.5` to `x = 1` (every 0.5 D). Reward: `-100 |T(x = D) / T_wall - 0.95|` on the centreline
+//! (the last probe).
+//!
+//! Resolution: 24, 32 and 48 cells per D (the throat is half of that). Coarser grids are not
+//! offered: at 12-20 cells per D (tau 0.518-0.53) the flow diverged at the inlet during the
+//! back-flow half of the oscillation.
+//!
+//! Known limitation: the D2Q5 scheme (linear equilibrium, BGK) at cell Peclet numbers
+//! `u dx / kappa` of 3-4 (coarse level, peak velocities) over- and undershoots slightly: with the
+//! inlet cooled to 0.5 a probe read 0.477 (tests/env_contract.rs prints it). A two-relaxation-time
+//! collision for the temperature would reduce it.
+//!
+//! Timing: the paper advances 4,000 solver steps per action (its step size is not given); we
+//! take 0.5 D/U, a twentieth of the oscillation period, so the 200 actions of an episode cover
+//! ten periods. Spin-up: 100 D/U (ten periods, and longer than the diffusive time across the
+//! channel, `Re Pr D / U = 71 D/U`).
+
+use super::actuation::Ramp;
+use super::spec::{ActuationSpec, EnvSpec, InflowSpec, Normalization, RewardSpec, ThermalSpec};
+use crate::validate::case::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
+
+pub const REYNOLDS: [u32; 1] = [100];
+
+/// The probes: the centreline from x = -3.5 to x = 1; the last one is the reward's.
+fn probes() -> Vec<[f64; 2]> {
+    (0..10).map(|k| [-3.5 + 0.5 * k as f64, 0.0]).collect()
+}
+
+/// `StenoticPipe_2D_Re{re}`.
+pub fn stenotic_pipe(re: u32) -> EnvSpec {
+    let probes = probes();
+    EnvSpec {
+        id: format!("StenoticPipe_2D_Re{re}"),
+        family: "stenotic_pipe".into(),
+        description: format!("2D channel with a cosine stenosis at Re {re}, oscillatory inflow (Womersley 4), inlet-temperature control"),
+        reynolds: re as f64,
+        bodies: vec![GeometrySpec::Stenosis {
+            center: [0.0, 0.0],
+            width: 1.0,
+            length: 2.0,
+            severity: 0.25,
+        }],
+        domain: DomainSpec {
+            x: [-4.0, 12.0],
+            y: [-0.5, 0.5],
+        },
+        boundaries: BoundarySpec {
+            west: BoundaryKind::Inlet,
+            east: BoundaryKind::Outlet,
+            south: BoundaryKind::Wall,
+            north: BoundaryKind::Wall,
+        },
+        resolution: ResolutionSpec {
+            coarse: 24,
+            default: 32,
+            fine: 48,
+        },
+        lattice_velocity: 0.05,
+        collision: hgym_solvers::lbm::Collision::Regularized,
+        smagorinsky: 0.0,
+        actuation: ActuationSpec::InletTemperature {
+            max_change: 0.05,
+            range: [0.5, 1.5],
+        },
+        ramp: Ramp::default(),
+        reward: RewardSpec::ProbeTemperature {
+            probe: probes.len() - 1,
+            target: 0.95,
+            weight: 100.0,
+        },
+        probes,
+        control_interval: 0.5,
+        episode_actions: 200,
+        spin_up: 100.0,
+        normalization: Normalization::default(),
+        gust: None,
+        sponge: None,
+        thermal: Some(Box::new(ThermalSpec {
+            prandtl: 0.71,
+            wall_temperature: 1.0,
+            inlet_temperature: 0.9,
+            initial_temperature: 0.9,
+        })),
+        inflow: Some(Box::new(InflowSpec {
+            womersley: 4.0,
+            noise: 0.05,
+        })),
+    }
+}
