@@ -506,19 +506,19 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
                             "id": s.id(), "family": s.family(), "dimension": 2, "reynolds": s.reynolds(),
                             "observations": s.obs_dim(), "actions": s.act_dim(), "solver": s.solver(),
                             "differentiable": s.differentiable(),
-                            "calibrated": calibrated(s), "spec_hash": s.hash(),
+                            "calibrated": calibrated(s), "validation": validation(s), "spec_hash": s.hash(),
                         })
                     })
                     .collect();
                 println!("{}", serde_json::to_string_pretty(&rows)?);
             } else {
                 println!(
-                    "{:<30} {:>3} {:>7} {:>5} {:>5} {:<10} {:<10} validation",
+                    "{:<30} {:>3} {:>7} {:>5} {:>5} {:<11} {:<10} validation",
                     "ID", "dim", "Re", "obs", "act", "solver", "calibrated"
                 );
                 for s in &specs {
                     println!(
-                        "{:<30} {:>3} {:>7} {:>5} {:>5} {:<10} {:<10} {}",
+                        "{:<30} {:>3} {:>7} {:>5} {:>5} {:<11} {:<10} {}",
                         s.id(),
                         "2D",
                         s.reynolds(),

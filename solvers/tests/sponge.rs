@@ -7,15 +7,20 @@ use std::sync::Arc;
 use hgym_solvers::geometry::{Rectangle, Shape};
 use hgym_solvers::lbm::{D2q9, D2q9Config, Edge, Side, Sides, Sponge};
 
+/// Periodic in x, `south` and `north` as given.
+fn periodic_in_x(south: Side, north: Side) -> Sides {
+    Sides {
+        west: Side::Periodic,
+        east: Side::Periodic,
+        south,
+        north,
+    }
+}
+
 /// A channel periodic in x between a no-slip floor and a free-slip top: the set-up of the open
 /// cavity's vertical direction.
 fn channel(ny: usize, sponge: Option<Sponge>) -> D2q9 {
-    let sides = Sides {
-        west: Side::Periodic,
-        east: Side::Periodic,
-        south: Side::Wall,
-        north: Side::FreeSlip,
-    };
+    let sides = periodic_in_x(Side::Wall, Side::FreeSlip);
     let mut cfg = D2q9Config::new(8, ny, 0.52, sides);
     cfg.sponges = sponge.into_iter().collect();
     D2q9::new(cfg, Vec::new()).unwrap()
@@ -77,12 +82,7 @@ fn a_flow_at_the_target_state_is_left_exactly_alone() {
     let ny = 32;
     let mut sp = top_sponge(ny);
     sp.u = [0.05, 0.0];
-    let sides = Sides {
-        west: Side::Periodic,
-        east: Side::Periodic,
-        south: Side::FreeSlip,
-        north: Side::FreeSlip,
-    };
+    let sides = periodic_in_x(Side::FreeSlip, Side::FreeSlip);
     let mut cfg = D2q9Config::new(8, ny, 0.6, sides);
     cfg.sponges = vec![sp];
     let mut s = D2q9::new(cfg, Vec::new()).unwrap();
@@ -142,12 +142,7 @@ fn bad_layers_are_refused_naming_the_problem() {
         (Edge::West, 8, 0.2, "periodic"),
     ];
     for (edge, width, strength, word) in cases {
-        let sides = Sides {
-            west: Side::Periodic,
-            east: Side::Periodic,
-            south: Side::Wall,
-            north: Side::FreeSlip,
-        };
+        let sides = periodic_in_x(Side::Wall, Side::FreeSlip);
         let mut cfg = D2q9Config::new(16, 64, 0.6, sides);
         cfg.sponges = vec![Sponge {
             edge,
@@ -166,12 +161,7 @@ fn bad_layers_are_refused_naming_the_problem() {
 /// reference pressure, so it is zero; a closed box in the same fluid also feels nothing.
 #[test]
 fn an_open_plate_in_fluid_at_rest_feels_no_force() {
-    let sides = Sides {
-        west: Side::Periodic,
-        east: Side::Periodic,
-        south: Side::Wall,
-        north: Side::FreeSlip,
-    };
+    let sides = periodic_in_x(Side::Wall, Side::FreeSlip);
     let plate: Arc<dyn Shape> = Arc::new(Rectangle {
         center: [16.0, 0.0],
         size: [100.0, 7.2],
