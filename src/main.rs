@@ -586,7 +586,8 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
             }
             let text = std::fs::read_to_string(&table)
                 .with_context(|| format!("cannot read {} (run from the repository root or pass --table)", table.display()))?;
-            let mut entries = hgym::env::calibrate::parse_table(&text).map_err(anyhow::Error::msg)?;
+            // Parsed now to fail fast on a broken table; read again before writing (below).
+            hgym::env::calibrate::parse_table(&text).map_err(anyhow::Error::msg)?;
             let (pool, _) = thread_pool(threads)?;
             let pb = progress_bar(actions as u64, &id);
             let entry = pool
@@ -600,10 +601,16 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
             if let Some([c_d, c_l]) = entry.mean_forces {
                 println!("{id}: uncontrolled mean C_D {c_d:.4}, mean C_L {c_l:.4}");
             }
+            // Re-read the table: other calibrations may have written their entries while this one
+            // ran (several IDs are often calibrated at once); then write atomically.
+            let text = std::fs::read_to_string(&table).with_context(|| format!("cannot read {}", table.display()))?;
+            let mut entries = hgym::env::calibrate::parse_table(&text).map_err(anyhow::Error::msg)?;
             entries.insert(id.clone(), entry);
             let header: String = text.lines().take_while(|l| l.starts_with('#')).map(|l| format!("{l}\n")).collect();
             let body = toml::to_string_pretty(&entries).context("cannot format the table")?;
-            std::fs::write(&table, format!("{header}\n{body}")).with_context(|| format!("cannot write {}", table.display()))?;
+            let tmp = table.with_extension(format!("tmp.{}", std::process::id()));
+            std::fs::write(&tmp, format!("{header}\n{body}")).with_context(|| format!("cannot write {}", tmp.display()))?;
+            std::fs::rename(&tmp, &table).with_context(|| format!("cannot replace {}", table.display()))?;
             println!(
                 "calibrated {id} at the {} level over {actions} actions; wrote {} (rebuild to embed)",
                 level.name(),
