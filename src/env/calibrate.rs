@@ -54,8 +54,15 @@ pub fn attach(spec: &mut EnvSpec, table: &BTreeMap<String, Entry>) {
     }
 }
 
+/// Smallest normalisation scale (units of U, rho U^2 or T_wall): 1 % of the free stream. A probe
+/// that hardly moves in the uncontrolled flow (a steady region; the open cavity at Re 4200, whose
+/// 2D flow is nearly steady) would otherwise get a scale near zero, and any actuation would give
+/// huge normalised observations and probe-deviation rewards. (Entries calibrated before this
+/// floor, up to 2026-11-23, used 1e-6.)
+pub const MIN_SCALE: f64 = 0.01;
+
 /// Runs `actions` uncontrolled control intervals from `reset(0)` and returns mean and
-/// 3-standard-deviation scale of every raw observation (scales floored at 1e-6).
+/// 3-standard-deviation scale of every raw observation, floored at [`MIN_SCALE`].
 pub fn calibrate(
     spec: &EnvSpec,
     level: Level,
@@ -95,7 +102,7 @@ pub fn calibrate(
     let scale = sq
         .iter()
         .zip(&mean)
-        .map(|(q, m)| 3.0 * (q / n - m * m).max(0.0).sqrt().max(1e-6 / 3.0))
+        .map(|(q, m)| (3.0 * (q / n - m * m).max(0.0).sqrt()).max(MIN_SCALE))
         .collect();
     Ok(Entry {
         spec_hash: physics_hash(spec),

@@ -98,6 +98,8 @@ pub fn reference_coefficients(re: u32, aoa: u32) -> Option<(f64, f64)> {
         (1000, 20) => Some((0.8761, 0.4776)),
         // Calibrated 2026-11-23 (default level, 100 actions): C_D 0.5762, C_L 0.7504.
         (100, 20) => Some((0.7504, 0.5762)),
+        // Calibrated 2026-11-23 (default level, 100 actions): C_D 1.0215, C_L 0.9417.
+        (100, 40) => Some((0.9417, 1.0215)),
         _ => None,
     }
 }
