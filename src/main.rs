@@ -605,7 +605,7 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
             // ran (several IDs are often calibrated at once); then write atomically.
             let text = std::fs::read_to_string(&table).with_context(|| format!("cannot read {}", table.display()))?;
             let mut entries = hgym::env::calibrate::parse_table(&text).map_err(anyhow::Error::msg)?;
-            entries.insert(id.clone(), entry);
+            entries.insert(hgym::env::calibrate::table_key(&id, level), entry);
             let header: String = text.lines().take_while(|l| l.starts_with('#')).map(|l| format!("{l}\n")).collect();
             let body = toml::to_string_pretty(&entries).context("cannot format the table")?;
             let tmp = table.with_extension(format!("tmp.{}", std::process::id()));

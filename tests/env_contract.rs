@@ -212,3 +212,17 @@ fn stenotic_pipe_inlet_temperature_is_a_rate_limited_actuator_that_reaches_the_p
     assert!(hot > cold + 0.05, "heating {hot} vs cooling {cold}");
     assert!(u_min < -0.2 && u_max > 0.2, "the inflow should oscillate: u in [{u_min}, {u_max}]");
 }
+
+/// Level-specific statistics: the cavity's coarse flow is calibrated on its own (`ID@coarse` in
+/// the table) and the env at that level uses them; IDs without such an entry keep the spec's.
+#[test]
+fn coarse_statistics_apply_only_where_committed() {
+    use hgym::env::calibrate::level_normalization;
+    let cavity = registry::get("Cavity_2D_Re4200").unwrap();
+    let coarse = level_normalization(&cavity, Level::Coarse).expect("Cavity_2D_Re4200@coarse is committed");
+    assert_eq!(coarse.mean.len(), cavity.obs_dim());
+    assert_ne!(coarse.mean, cavity.normalization.mean);
+    assert!(level_normalization(&cavity, Level::Default).is_none());
+    let cylinder = registry::get("Cylinder_2D_Re100").unwrap();
+    assert!(level_normalization(&cylinder, Level::Coarse).is_none());
+}

@@ -42,10 +42,39 @@ pub fn parse_table(text: &str) -> Result<BTreeMap<String, Entry>, String> {
     toml::from_str(text).map_err(|e| format!("benchmarks/envs/normalization.toml: {e}"))
 }
 
+/// The table key of `id`'s statistics at `level`: the ID itself for the default level (the
+/// statistics a spec carries), `ID@level` for another level whose flow differs too much from the
+/// default one for those to hold (the open cavity at coarse: its 40-cells-per-depth flow is a
+/// different recirculation, observations up to 16 default-scales away).
+pub fn table_key(id: &str, level: Level) -> String {
+    match level {
+        Level::Default => id.to_string(),
+        other => format!("{id}@{}", other.name()),
+    }
+}
+
+/// The committed statistics of `spec` at `level` when there is a level-specific entry (see
+/// [`table_key`]); `None` means the spec's own (default-level) normalisation applies.
+pub fn level_normalization(spec: &EnvSpec, level: Level) -> Option<Normalization> {
+    if level == Level::Default {
+        return None;
+    }
+    let table = parse_table(TABLE).ok()?;
+    let mut probe = spec.clone();
+    probe.normalization = Normalization::default();
+    attach_entry(&mut probe, table.get(&table_key(&spec.id, level)), &physics_hash(spec));
+    (!probe.normalization.mean.is_empty()).then_some(probe.normalization)
+}
+
 /// Attaches the committed statistics to `spec` when they were computed for the same physics.
 pub fn attach(spec: &mut EnvSpec, table: &BTreeMap<String, Entry>) {
-    if let Some(e) = table.get(&spec.id) {
-        if e.spec_hash == physics_hash(spec) && e.mean.len() == spec.obs_dim() && e.scale.len() == spec.obs_dim() {
+    let hash = physics_hash(spec);
+    attach_entry(spec, table.get(&spec.id), &hash);
+}
+
+fn attach_entry(spec: &mut EnvSpec, entry: Option<&Entry>, hash: &str) {
+    if let Some(e) = entry {
+        if e.spec_hash == hash && e.mean.len() == spec.obs_dim() && e.scale.len() == spec.obs_dim() {
             spec.normalization = Normalization {
                 mean: e.mean.clone(),
                 scale: e.scale.clone(),

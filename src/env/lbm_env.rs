@@ -74,7 +74,12 @@ fn backend(e: impl std::fmt::Display) -> EnvError {
 impl LbmEnv {
     /// Builds the solver for `spec` at `level`; `cache_dir` keeps developed-flow states between
     /// processes (none: in memory only).
-    pub fn new(spec: EnvSpec, level: Level, cache_dir: Option<PathBuf>) -> Result<Self, EnvError> {
+    pub fn new(mut spec: EnvSpec, level: Level, cache_dir: Option<PathBuf>) -> Result<Self, EnvError> {
+        // Level-specific statistics where the committed table has them (the spec carries the
+        // default level's).
+        if let Some(n) = super::calibrate::level_normalization(&spec, level) {
+            spec.normalization = n;
+        }
         let n = spec.cells_per_length(level) as f64;
         let units = Units {
             cells_per_length: n,

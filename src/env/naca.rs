@@ -100,6 +100,8 @@ pub fn reference_coefficients(re: u32, aoa: u32) -> Option<(f64, f64)> {
         (100, 20) => Some((0.7504, 0.5762)),
         // Calibrated 2026-11-23 (default level, 100 actions): C_D 1.0215, C_L 0.9417.
         (100, 40) => Some((0.9417, 1.0215)),
+        // Calibrated 2026-11-23 (default level, 100 actions): C_D 1.9763, C_L 2.1831.
+        (1000, 40) => Some((2.1831, 1.9763)),
         _ => None,
     }
 }
