@@ -596,16 +596,19 @@ impl D2q9 {
     }
 
     /// Fills density and velocity fields (row-major `y * nx + x`, lattice units).
+    /// Rows run in parallel (each node is independent: the same result for any thread count).
     pub fn macroscopic(&self, rho: &mut [f32], ux: &mut [f32], uy: &mut [f32]) {
         let nx = self.cfg.nx;
-        for y in 0..self.cfg.ny {
-            for x in 0..nx {
-                let (r, u, v) = self.node(x, y);
-                rho[y * nx + x] = r;
-                ux[y * nx + x] = u;
-                uy[y * nx + x] = v;
-            }
-        }
+        rho.par_chunks_mut(nx)
+            .zip(ux.par_chunks_mut(nx))
+            .zip(uy.par_chunks_mut(nx))
+            .take(self.cfg.ny)
+            .enumerate()
+            .for_each(|(y, ((r, u), v))| {
+                for x in 0..nx.min(r.len()) {
+                    (r[x], u[x], v[x]) = self.node(x, y);
+                }
+            });
     }
 
     /// Total mass `sum rho` over fluid nodes, in f64.

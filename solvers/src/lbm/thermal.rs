@@ -20,6 +20,8 @@
 //! Populations are `f32`; two arrays (A-B), direction-major (`g[i * n + cell]`). The step
 //! allocates nothing.
 
+use rayon::prelude::*;
+
 use super::domain::Edge;
 use super::error::LbmError;
 
@@ -55,6 +57,70 @@ pub struct Thermal {
     /// West, east, south, north.
     sides: [ThermalSide; 4],
     time: u64,
+}
+
+/// What one step reads (split from the solver so the destination can be borrowed mutably).
+struct StepCtx<'a> {
+    nx: usize,
+    ny: usize,
+    g: &'a [f32],
+    solid: &'a [bool],
+    sides: [ThermalSide; 4],
+    wall_temperature: f32,
+    omega: f32,
+    ux: &'a [f32],
+    uy: &'a [f32],
+}
+
+impl StepCtx<'_> {
+    /// Stream (pull, with the boundary rules for populations that come from a wall or from
+    /// outside) and collide every fluid node of row `y`; `out[i]` is row `y` of direction `i`.
+    // `x` is a lattice coordinate (neighbours, sides), not only an index.
+    #[allow(clippy::needless_range_loop)]
+    fn row(&self, y: usize, out: [&mut [f32]; Q5]) {
+        let (nx, ny, g) = (self.nx, self.ny, self.g);
+        let n = nx * ny;
+        for x in 0..nx {
+            let c = y * nx + x;
+            if self.solid[c] {
+                continue;
+            }
+            let mut p = [0.0f32; Q5];
+            for (i, pi) in p.iter_mut().enumerate() {
+                let (sx, sy) = (x as isize - CX5[i] as isize, y as isize - CY5[i] as isize);
+                let outside = match (sx < 0, sx >= nx as isize, sy < 0, sy >= ny as isize) {
+                    (true, _, _, _) => Some(self.sides[0]),
+                    (_, true, _, _) => Some(self.sides[1]),
+                    (_, _, true, _) => Some(self.sides[2]),
+                    (_, _, _, true) => Some(self.sides[3]),
+                    _ => None,
+                };
+                let own_opp = g[OPP5[i] * n + c];
+                *pi = match outside {
+                    None => {
+                        let s = sy as usize * nx + sx as usize;
+                        if self.solid[s] {
+                            -own_opp + 2.0 * W5[i] * self.wall_temperature
+                        } else {
+                            g[i * n + s]
+                        }
+                    }
+                    Some(ThermalSide::Periodic) => {
+                        let s = sy.rem_euclid(ny as isize) as usize * nx + sx.rem_euclid(nx as isize) as usize;
+                        g[i * n + s]
+                    }
+                    Some(ThermalSide::Temperature(t)) => -own_opp + 2.0 * W5[i] * t,
+                    Some(ThermalSide::ZeroGradient) => g[i * n + c],
+                };
+            }
+            let t: f32 = p.iter().sum();
+            let (u, v) = (self.ux[c], self.uy[c]);
+            for (i, pi) in p.iter().enumerate() {
+                let eq = W5[i] * t * (1.0 + 3.0 * (CX5[i] as f32 * u + CY5[i] as f32 * v));
+                out[i][x] = pi - self.omega * (pi - eq);
+            }
+        }
+    }
 }
 
 fn side_index(e: Edge) -> usize {
@@ -139,56 +205,38 @@ impl Thermal {
         }
     }
 
-    /// One step with the flow's velocity field `ux`, `uy` (row-major, lattice units).
+    /// One step with the flow's velocity field `ux`, `uy` (row-major, lattice units). Rows run
+    /// in parallel; every node's update depends only on the previous populations, so the result
+    /// is the same for any thread count.
     pub fn step(&mut self, ux: &[f32], uy: &[f32]) {
-        let (nx, ny) = (self.nx, self.ny);
-        let n = nx * ny;
-        let (g, next) = (&self.g, &mut self.g_next);
-        for y in 0..ny {
-            for x in 0..nx {
-                let c = y * nx + x;
-                if self.solid[c] {
-                    continue;
-                }
-                // Stream (pull), with the boundary rules for populations that come from a wall
-                // or from outside.
-                let mut p = [0.0f32; Q5];
-                for (i, pi) in p.iter_mut().enumerate() {
-                    let (sx, sy) = (x as isize - CX5[i] as isize, y as isize - CY5[i] as isize);
-                    let outside = match (sx < 0, sx >= nx as isize, sy < 0, sy >= ny as isize) {
-                        (true, _, _, _) => Some(self.sides[0]),
-                        (_, true, _, _) => Some(self.sides[1]),
-                        (_, _, true, _) => Some(self.sides[2]),
-                        (_, _, _, true) => Some(self.sides[3]),
-                        _ => None,
-                    };
-                    let own_opp = g[OPP5[i] * n + c];
-                    *pi = match outside {
-                        None => {
-                            let s = sy as usize * nx + sx as usize;
-                            if self.solid[s] {
-                                -own_opp + 2.0 * W5[i] * self.wall_temperature
-                            } else {
-                                g[i * n + s]
-                            }
-                        }
-                        Some(ThermalSide::Periodic) => {
-                            let s = sy.rem_euclid(ny as isize) as usize * nx + sx.rem_euclid(nx as isize) as usize;
-                            g[i * n + s]
-                        }
-                        Some(ThermalSide::Temperature(t)) => -own_opp + 2.0 * W5[i] * t,
-                        Some(ThermalSide::ZeroGradient) => g[i * n + c],
-                    };
-                }
-                // Collide.
-                let t: f32 = p.iter().sum();
-                let (u, v) = (ux[c], uy[c]);
-                for (i, pi) in p.iter().enumerate() {
-                    let eq = W5[i] * t * (1.0 + 3.0 * (CX5[i] as f32 * u + CY5[i] as f32 * v));
-                    next[i * n + c] = pi - self.omega * (pi - eq);
-                }
-            }
-        }
+        let n = self.nx * self.ny;
+        let ctx = StepCtx {
+            nx: self.nx,
+            ny: self.ny,
+            g: &self.g,
+            solid: &self.solid,
+            sides: self.sides,
+            wall_temperature: self.wall_temperature,
+            omega: self.omega,
+            ux,
+            uy,
+        };
+        // The five direction planes of the destination, split into rows.
+        let (p0, rest) = self.g_next.split_at_mut(n);
+        let (p1, rest) = rest.split_at_mut(n);
+        let (p2, rest) = rest.split_at_mut(n);
+        let (p3, p4) = rest.split_at_mut(n);
+        let nx = self.nx;
+        (
+            p0.par_chunks_mut(nx),
+            p1.par_chunks_mut(nx),
+            p2.par_chunks_mut(nx),
+            p3.par_chunks_mut(nx),
+            p4.par_chunks_mut(nx),
+        )
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(y, (r0, r1, r2, r3, r4))| ctx.row(y, [r0, r1, r2, r3, r4]));
         std::mem::swap(&mut self.g, &mut self.g_next);
         self.time += 1;
     }
