@@ -37,6 +37,12 @@ pub fn physics_hash(spec: &EnvSpec) -> String {
     s.hash()
 }
 
+/// The committed table, parsed once (empty if broken: a test checks that it parses).
+pub fn table() -> &'static BTreeMap<String, Entry> {
+    static PARSED: std::sync::OnceLock<BTreeMap<String, Entry>> = std::sync::OnceLock::new();
+    PARSED.get_or_init(|| parse_table(TABLE).unwrap_or_default())
+}
+
 /// Parses a table; a malformed one yields an error naming the problem.
 pub fn parse_table(text: &str) -> Result<BTreeMap<String, Entry>, String> {
     toml::from_str(text).map_err(|e| format!("benchmarks/envs/normalization.toml: {e}"))
@@ -59,7 +65,7 @@ pub fn level_normalization(spec: &EnvSpec, level: Level) -> Option<Normalization
     if level == Level::Default {
         return None;
     }
-    let table = parse_table(TABLE).ok()?;
+    let table = table();
     let mut probe = spec.clone();
     probe.normalization = Normalization::default();
     attach_entry(&mut probe, table.get(&table_key(&spec.id, level)), &physics_hash(spec));

@@ -28,6 +28,7 @@ use hgym_solvers::spectral::{Complex64 as C, Kolmogorov, KolmogorovConfig};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use super::seeding::splitmix64;
 use crate::validate::case::{Level, ResolutionSpec};
 
 pub const REYNOLDS: [u32; 3] = [40, 100, 200];
@@ -178,13 +179,6 @@ pub fn all() -> Vec<KolmogorovSpec> {
 fn attractors() -> &'static Mutex<HashMap<String, Vec<C>>> {
     static CACHE: OnceLock<Mutex<HashMap<String, Vec<C>>>> = OnceLock::new();
     CACHE.get_or_init(|| Mutex::new(HashMap::new()))
-}
-
-fn splitmix64(seed: u64) -> u64 {
-    let mut z = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 fn backend(e: impl std::fmt::Display) -> EnvError {

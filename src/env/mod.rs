@@ -19,6 +19,7 @@ pub mod pinball;
 pub mod pipe;
 pub mod registry;
 pub mod rollout;
+mod seeding;
 pub mod spec;
 pub mod square;
 

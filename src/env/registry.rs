@@ -42,9 +42,8 @@ pub fn all() -> Vec<EnvSpec> {
         v.push(pipe::stenotic_pipe(re));
     }
     // The table is checked by a test; a broken one only means uncalibrated observations.
-    let table = calibrate::parse_table(calibrate::TABLE).unwrap_or_default();
     for s in &mut v {
-        calibrate::attach(s, &table);
+        calibrate::attach(s, calibrate::table());
     }
     v
 }

@@ -19,7 +19,7 @@ mod error;
 mod forces;
 mod kernel;
 pub mod lattice;
-mod probes;
+pub(crate) mod probes;
 mod solver;
 pub mod sponge;
 pub mod thermal;

@@ -22,17 +22,8 @@ impl D2q9 {
                 ymax: hi[1],
             });
         }
-        let x0 = (xi.floor() as usize).min(nx - 2);
-        let y0 = (eta.floor() as usize).min(ny - 2);
-        let (tx, ty) = (xi - x0 as f64, eta - y0 as f64);
         let mut out = [0.0f64; 3];
-        for (dx, dy, w) in [
-            (0, 0, (1.0 - tx) * (1.0 - ty)),
-            (1, 0, tx * (1.0 - ty)),
-            (0, 1, (1.0 - tx) * ty),
-            (1, 1, tx * ty),
-        ] {
-            let (x, y) = (x0 + dx, y0 + dy);
+        for (x, y, w) in bilinear(xi, eta, nx, ny) {
             let (rho, ux, uy) = if self.is_solid(x, y) { (1.0, 0.0, 0.0) } else { self.node(x, y) };
             out[0] += w * rho as f64;
             out[1] += w * ux as f64;
@@ -40,4 +31,18 @@ impl D2q9 {
         }
         Ok(out)
     }
+}
+
+/// The bilinear stencil at lattice coordinates `(xi, eta)` (node `(i, j)` at `(i, j)`, inside the
+/// grid): the four surrounding nodes and their weights, in a fixed order.
+pub(crate) fn bilinear(xi: f64, eta: f64, nx: usize, ny: usize) -> [(usize, usize, f64); 4] {
+    let x0 = (xi.floor() as usize).min(nx - 2);
+    let y0 = (eta.floor() as usize).min(ny - 2);
+    let (tx, ty) = (xi - x0 as f64, eta - y0 as f64);
+    [
+        (x0, y0, (1.0 - tx) * (1.0 - ty)),
+        (x0 + 1, y0, tx * (1.0 - ty)),
+        (x0, y0 + 1, (1.0 - tx) * ty),
+        (x0 + 1, y0 + 1, tx * ty),
+    ]
 }

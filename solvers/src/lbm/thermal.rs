@@ -24,6 +24,7 @@ use rayon::prelude::*;
 
 use super::domain::Edge;
 use super::error::LbmError;
+use super::probes::bilinear;
 
 /// Number of discrete velocities of D2Q5.
 pub const Q5: usize = 5;
@@ -256,14 +257,10 @@ impl Thermal {
     pub fn sample(&self, xi: f64, eta: f64) -> f64 {
         let xi = xi.clamp(0.0, (self.nx - 1) as f64);
         let eta = eta.clamp(0.0, (self.ny - 1) as f64);
-        let x0 = (xi.floor() as usize).min(self.nx - 2);
-        let y0 = (eta.floor() as usize).min(self.ny - 2);
-        let (tx, ty) = (xi - x0 as f64, eta - y0 as f64);
-        let t = |x: usize, y: usize| self.temperature(x, y) as f64;
-        (1.0 - tx) * (1.0 - ty) * t(x0, y0)
-            + tx * (1.0 - ty) * t(x0 + 1, y0)
-            + (1.0 - tx) * ty * t(x0, y0 + 1)
-            + tx * ty * t(x0 + 1, y0 + 1)
+        bilinear(xi, eta, self.nx, self.ny)
+            .iter()
+            .map(|&(x, y, w)| w * self.temperature(x, y) as f64)
+            .sum()
     }
 
     /// Sum of the temperature over fluid nodes (the conserved "heat" of a closed domain).
