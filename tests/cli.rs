@@ -155,6 +155,126 @@ fn body_larger_than_the_domain_is_refused() {
     );
 }
 
+/// The measured value of quantity `q` in a report.
+fn measured(report: &serde_json::Value, q: &str) -> f64 {
+    let quantity = report["quantities"].as_array().unwrap().iter().find(|x| x["name"] == q);
+    quantity.unwrap_or_else(|| panic!("no {q} in the report"))["measured"]
+        .as_f64()
+        .unwrap()
+}
+
+/// `[[sponge]]` tables for `edges`, `thickness` L thick.
+fn sponges(edges: &[&str], thickness: f64) -> String {
+    edges
+        .iter()
+        .map(|e| format!("[[sponge]]\nedge = \"{e}\"\nthickness = {thickness}\nstrength = 0.05\n\n"))
+        .collect()
+}
+
+#[test]
+fn bad_absorbing_layers_are_refused_naming_the_problem() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, layers, expect) in [
+        ("twice", sponges(&["west", "west"], 2.0), "two layers on the West edge"),
+        ("deep", sponges(&["west"], 19.6), "reaches a body"),
+        ("seam", sponges(&["north"], 2.0), "periodic"),
+    ] {
+        let case = format!("{}\n{layers}", small_case(&[]));
+        let p = write_case(dir.path(), name, &case);
+        let o = hgym(&[
+            "validate",
+            "--case",
+            p.to_str().unwrap(),
+            "--level",
+            "coarse",
+            "--out",
+            dir.path().to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{name}");
+        let (_, err) = text(&o);
+        assert!(err.contains(expect), "{name}: {err}");
+    }
+}
+
+/// The absorbing layers let the pressure waves of the impulsive start leave the domain: in a
+/// steady flow (cylinder, Re 40) between a velocity inlet, an outlet and free-slip sides the
+/// drag still rings after 30 L/U without them, and is quiet with them, at the same mean.
+#[test]
+fn absorbing_layers_remove_the_acoustic_ringing_of_the_start() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, layers: &str| -> serde_json::Value {
+        let case = small_case(&[
+            ("name = \"cylinder_re100\"", &format!("name = \"{name}\"")),
+            ("reynolds = 100.0", "reynolds = 40.0"),
+            ("perturbation = 0.3", "perturbation = 0.0"),
+            ("x = [0.0, 60.0]", "x = [0.0, 30.0]"),
+            ("y = [-20.0, 20.0]", "y = [-10.0, 10.0]"),
+            ("center = [20.0, 0.0]", "center = [10.0, 0.0]"),
+            ("south = \"periodic\"", "south = \"free-slip\""),
+            ("north = \"periodic\"", "north = \"free-slip\""),
+            ("spin_up = 50.0", "spin_up = 30.0"),
+            ("average = 40.0", "average = 10.0"),
+            (
+                "quantities = [\"strouhal\", \"mean_cd\", \"cl_amplitude\"]",
+                "quantities = [\"mean_cd\", \"cd_amplitude\"]",
+            ),
+            ("[[reference]]", &format!("{layers}[[ignored]]")),
+        ]);
+        // Keep the case's references out (they are for Re 100): cut everything after the marker.
+        let case = case.split("[[ignored]]").next().unwrap().to_string();
+        let p = write_case(dir.path(), name, &case);
+        let out = dir.path().join("out");
+        let o = hgym(&[
+            "validate",
+            "--case",
+            p.to_str().unwrap(),
+            "--level",
+            "coarse",
+            "--out",
+            out.to_str().unwrap(),
+            "--json",
+        ]);
+        let (stdout, stderr) = text(&o);
+        assert_eq!(o.status.code(), Some(0), "stdout: {stdout}\nstderr: {stderr}");
+        let reports: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        reports[0].clone()
+    };
+    let bare = run("bare", "");
+    let layered = run("layered", &sponges(&["west", "east", "south", "north"], 2.0));
+    let (ring_bare, ring_layered) = (measured(&bare, "cd_amplitude"), measured(&layered, "cd_amplitude"));
+    let (cd_bare, cd_layered) = (measured(&bare, "mean_cd"), measured(&layered, "mean_cd"));
+    println!("C_D ringing {ring_bare:.2e} -> {ring_layered:.2e}, mean {cd_bare:.4} -> {cd_layered:.4}");
+    assert!(ring_layered < 0.1 * ring_bare, "ringing {ring_bare:.2e} -> {ring_layered:.2e}");
+    assert!((cd_layered - cd_bare).abs() < 0.03 * cd_bare, "mean C_D {cd_bare} -> {cd_layered}");
+}
+
+/// Per-cylinder forces of the three-body pinball against a second solver: HydroGym's Firedrake
+/// steady Re 30 solution in its own domain (the bundled case at its 16-cells-per-D level).
+#[test]
+fn pinball_forces_match_hydrogym_firedrake_steady_solution() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = repo().join("benchmarks/validation/pinball_re30_steady.toml");
+    let o = hgym(&[
+        "validate",
+        "--case",
+        case.to_str().unwrap(),
+        "--level",
+        "coarse",
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--json",
+    ]);
+    let (stdout, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "stdout: {stdout}\nstderr: {stderr}");
+    let reports: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let value = |q: &str| measured(&reports[0], q);
+    // The mirror-symmetric grid keeps the unstable symmetric state: equal rear drags, opposite lifts.
+    assert!((value("mean_cd_2") - value("mean_cd_3")).abs() < 1e-4);
+    assert!((value("mean_cl_2") + value("mean_cl_3")).abs() < 1e-4);
+    assert!(value("mean_cl_1").abs() < 1e-3);
+    schema_check(&reports[0]);
+}
+
 #[test]
 fn blow_up_exits_1_naming_step_and_cause_with_plots_written() {
     let dir = tempfile::tempdir().unwrap();

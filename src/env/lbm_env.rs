@@ -21,7 +21,7 @@ use std::path::PathBuf;
 
 use hgym_agents::{checked_action, BoxSpace, Env, EnvError, Info, StepResult};
 use hgym_solvers::lbm::thermal::{Thermal, ThermalSide};
-use hgym_solvers::lbm::{D2q9, D2q9Config, Edge, Grid, LbmError, Side, Sponge, Units};
+use hgym_solvers::lbm::{D2q9, D2q9Config, Edge, Grid, LbmError, Side, Units};
 
 use super::actuation::{apply, Jet, WallMotion};
 use super::seeding::splitmix64;
@@ -105,13 +105,7 @@ impl LbmEnv {
         cfg.grid = grid;
         cfg.check_interval = 100;
         if let Some(sp) = &spec.sponge {
-            cfg.sponges.push(Sponge {
-                edge: sp.edge.lattice(),
-                width: ((sp.thickness * n).round() as usize).max(1),
-                strength: sp.strength,
-                rho: 1.0,
-                u: [spec.lattice_velocity, 0.0],
-            });
+            cfg.sponges.push(sp.lattice(n, spec.lattice_velocity));
         }
         let bodies = spec.bodies.iter().map(build_shape).collect();
         let solver = D2q9::new(cfg, bodies).map_err(backend)?;

@@ -11,6 +11,7 @@ use hgym_solvers::lbm::Collision;
 
 use super::actuation::{Jet, Ramp};
 use crate::validate::case::{BoundarySpec, DomainSpec, GeometrySpec, Level, ResolutionSpec};
+pub use crate::validate::case::{EdgeName, SpongeSpec};
 
 /// The actuators of an environment; actions in `[-1, 1]` are scaled by the bound given here.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -160,39 +161,6 @@ impl InflowSpec {
     pub fn omega(&self, re: f64) -> f64 {
         4.0 * self.womersley * self.womersley / re
     }
-}
-
-/// An edge of the rectangular domain, by compass direction.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
-#[serde(rename_all = "snake_case")]
-pub enum EdgeName {
-    West,
-    East,
-    South,
-    North,
-}
-
-impl EdgeName {
-    pub fn lattice(self) -> hgym_solvers::lbm::Edge {
-        use hgym_solvers::lbm::Edge;
-        match self {
-            EdgeName::West => Edge::West,
-            EdgeName::East => Edge::East,
-            EdgeName::South => Edge::South,
-            EdgeName::North => Edge::North,
-        }
-    }
-}
-
-/// An absorbing layer (see `hgym_solvers::lbm::sponge`): `thickness` in reference lengths,
-/// `strength` the relaxation per lattice step at the edge (the ramp is quadratic), target the
-/// free stream `(rho, u) = (1, U)`.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct SpongeSpec {
-    pub edge: EdgeName,
-    pub thickness: f64,
-    pub strength: f64,
 }
 
 /// A "1 - cos" transverse gust imposed at the inflow (the paper's gust-airfoil set-up): the

@@ -7,6 +7,14 @@
 //! taken between the first and the last crossing, i.e. over whole periods. The lift spectrum
 //! (Hann window, zero-padded FFT, peak refined by a parabola through the log-magnitudes) gives a
 //! second, independent frequency estimate.
+//!
+//! The frequency sought is the fundamental (the inverse of the period), which need not be the
+//! tallest peak: the fluidic pinball's total lift at Re 100 has its third harmonic above its
+//! fundamental, as the lifts of the three cylinders partly cancel. The spectral estimate is
+//! therefore the lowest peak of at least a quarter of the tallest one of which the tallest is a
+//! harmonic (2nd to 6th, within 3 %), and the crossings are counted on the lift low-passed by two
+//! centred moving averages over a half and a third of that period, which null the 2nd and 3rd
+//! harmonics (and their multiples) and leave the timing of the fundamental's crossings unchanged.
 
 use realfft::RealFftPlanner;
 use serde::Serialize;
@@ -55,16 +63,29 @@ pub fn spectrum(t: &[f64], signal: &[f64]) -> (Vec<f64>, Vec<f64>) {
     (freqs, amps)
 }
 
-fn spectral_peak(freqs: &[f64], amps: &[f64]) -> Option<f64> {
-    if amps.len() < 3 {
-        return None;
-    }
-    let k = (1..amps.len() - 1).max_by(|&a, &b| amps[a].total_cmp(&amps[b]))?;
+/// Frequency of the peak at bin `k`, refined by a parabola through the log-magnitudes.
+fn refined_peak(freqs: &[f64], amps: &[f64], k: usize) -> f64 {
     let (a, b, c) = (amps[k - 1].max(1e-300).ln(), amps[k].max(1e-300).ln(), amps[k + 1].max(1e-300).ln());
     let den = a - 2.0 * b + c;
     let shift = if den.abs() > 0.0 { 0.5 * (a - c) / den } else { 0.0 };
     let df = freqs[1] - freqs[0];
-    Some(freqs[k] + shift.clamp(-0.5, 0.5) * df)
+    freqs[k] + shift.clamp(-0.5, 0.5) * df
+}
+
+/// The fundamental frequency of the spectrum (see the module doc): the lowest local maximum of at
+/// least a quarter of the tallest peak whose 2nd to 6th multiple lies within 3 % of the tallest,
+/// else the tallest.
+fn spectral_fundamental(freqs: &[f64], amps: &[f64]) -> Option<f64> {
+    if amps.len() < 3 {
+        return None;
+    }
+    let top = (1..amps.len() - 1).max_by(|&a, &b| amps[a].total_cmp(&amps[b]))?;
+    let f_top = refined_peak(freqs, amps, top);
+    let fundamental = (1..top)
+        .filter(|&k| amps[k] >= 0.25 * amps[top] && amps[k] >= amps[k - 1] && amps[k] >= amps[k + 1])
+        .map(|k| refined_peak(freqs, amps, k))
+        .find(|&f| (2..=6).any(|m| (m as f64 * f - f_top).abs() <= 0.03 * f_top));
+    Some(fundamental.unwrap_or(f_top))
 }
 
 /// Centred moving average over `2 half + 1` samples (shorter at the ends).
@@ -99,17 +120,20 @@ pub fn analyse(t: &[f64], cd: &[f64], cl: &[f64], t_start: f64) -> Analysis {
     let std = (cl.iter().map(|v| (v - m_cl).powi(2)).sum::<f64>() / n as f64).sqrt();
     let hyst = 0.1 * std;
     let (freqs, amps) = spectrum(t, cl);
-    let strouhal_spectral = if std > 1e-9 { spectral_peak(&freqs, &amps) } else { None };
-    // Crossings are found on the lift smoothed over a tenth of the spectral period (a centred
-    // moving average), so that high-frequency noise cannot add spurious crossings; means and
-    // amplitudes use the raw signal.
+    let strouhal_spectral = if std > 1e-9 { spectral_fundamental(&freqs, &amps) } else { None };
+    // Crossings are found on the lift low-passed by centred moving averages over a half and a
+    // third of the fundamental period (see the module doc), so that harmonics and high-frequency
+    // noise cannot add crossings; means and amplitudes use the raw signal.
     let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
-    let half = strouhal_spectral.map_or(0, |f| ((0.05 / (f * dt)).round() as usize).min(n / 4));
-    let smooth = moving_average(cl, half);
+    let half_width = |fraction: f64| strouhal_spectral.map_or(0, |f| ((0.5 * fraction / (f * dt)).round() as usize).min(n / 4));
+    let (h2, h3) = (half_width(1.0 / 2.0), half_width(1.0 / 3.0));
+    let smooth = moving_average(&moving_average(cl, h2), h3);
+    // Near the ends the averages are one-sided and would shift the crossings: skip those samples.
+    let edge = h2 + h3;
     // Upward crossings (time, sample index after the crossing).
     let mut crossings: Vec<(f64, usize)> = Vec::new();
     let mut armed = false;
-    for j in 1..n {
+    for j in (edge + 1)..n.saturating_sub(edge) {
         let (a, b) = (smooth[j - 1] - m_cl, smooth[j] - m_cl);
         if a < -hyst {
             armed = true;
@@ -212,6 +236,40 @@ mod tests {
         let cd = vec![1.3; t.len()];
         let a = analyse(&t, &cd, &cl, 10.0);
         assert!((a.strouhal.unwrap() - st).abs() < 1e-3, "{:?}", a.strouhal);
+    }
+
+    /// The pinball's total lift at Re 100: a fundamental at 0.0905 below its 2nd and above-it 3rd
+    /// harmonic (amplitudes as measured: 0.0044, 0.0032, 0.0058).
+    #[test]
+    fn a_dominant_harmonic_does_not_multiply_the_frequency() {
+        let dt = 0.0025;
+        let st = 0.0905;
+        let t: Vec<f64> = (0..120_000).map(|j| j as f64 * dt).collect();
+        let w = 2.0 * std::f64::consts::PI * st;
+        let cl: Vec<f64> = t
+            .iter()
+            .map(|t| 0.03 + 0.0044 * (w * t).sin() + 0.0032 * (2.0 * w * t + 0.7).sin() + 0.0058 * (3.0 * w * t + 1.9).sin())
+            .collect();
+        let cd = vec![2.97; t.len()];
+        let a = analyse(&t, &cd, &cl, 10.0);
+        assert!((a.strouhal.unwrap() - st).abs() < 1e-3, "{:?}", a.strouhal);
+        assert!((a.strouhal_spectral.unwrap() - st).abs() < 2e-3, "{:?}", a.strouhal_spectral);
+        assert!((a.mean_cl - 0.03).abs() < 1e-4, "{}", a.mean_cl);
+    }
+
+    /// Two unrelated tones: the taller one is the frequency, whichever is lower.
+    #[test]
+    fn an_unrelated_lower_tone_is_not_taken_for_the_fundamental() {
+        let dt = 0.005;
+        let t: Vec<f64> = (0..60_000).map(|j| j as f64 * dt).collect();
+        let tau = 2.0 * std::f64::consts::PI;
+        let cl: Vec<f64> = t
+            .iter()
+            .map(|t| 0.5 * (tau * 0.2 * t).sin() + 0.2 * (tau * 0.077 * t).sin())
+            .collect();
+        let cd = vec![1.0; t.len()];
+        let a = analyse(&t, &cd, &cl, 5.0);
+        assert!((a.strouhal_spectral.unwrap() - 0.2).abs() < 2e-3, "{:?}", a.strouhal_spectral);
     }
 
     #[test]

@@ -1,8 +1,9 @@
 //! Validation cases as data: the TOML format, its checks, and the bundled cases.
 //!
 //! A case file says what it checks (`[case]`), the set-up (`[geometry]`, `[domain]`,
-//! `[boundaries]`, `[inlet]`, `[flow]`, `[resolution]`, `[time]`), which quantities to measure
-//! (`[measure]`) and the reference values with their sources and tolerances (`[[reference]]`).
+//! `[boundaries]`, `[inlet]`, `[flow]`, `[resolution]`, `[time]`, optional absorbing layers
+//! `[[sponge]]`), which quantities to measure (`[measure]`) and the reference values with their
+//! sources and tolerances (`[[reference]]`).
 //! Lengths are in units of the body's reference length (diameter, side or chord), velocities in
 //! units of the reference velocity U, times in L/U. Every key is checked: an unknown key is an
 //! error that names it. See `benchmarks/validation/*.toml` for complete examples.
@@ -31,6 +32,10 @@ pub const BUNDLED: &[(&str, &str)] = &[
     ("pinball_re30.toml", include_str!("../../benchmarks/validation/pinball_re30.toml")),
     ("pinball_re100.toml", include_str!("../../benchmarks/validation/pinball_re100.toml")),
     ("pinball_re150.toml", include_str!("../../benchmarks/validation/pinball_re150.toml")),
+    (
+        "pinball_re30_steady.toml",
+        include_str!("../../benchmarks/validation/pinball_re30_steady.toml"),
+    ),
     ("square_re200.toml", include_str!("../../benchmarks/validation/square_re200.toml")),
     ("square_re1000.toml", include_str!("../../benchmarks/validation/square_re1000.toml")),
 ];
@@ -59,8 +64,61 @@ pub struct Case {
     pub resolution: ResolutionSpec,
     pub time: TimeSpec,
     pub measure: MeasureSpec,
+    /// Absorbing layers (`[[sponge]]`) that let pressure waves leave the domain: without them the
+    /// waves of the impulsive start stay trapped between a velocity inlet, an outlet and periodic
+    /// sides, where the weak viscosity at Re >= 30 takes hundreds of L/U to damp them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sponge: Vec<SpongeSpec>,
     #[serde(default)]
     pub reference: Vec<ReferenceSpec>,
+}
+
+/// An edge of the rectangular domain, by compass direction.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(rename_all = "snake_case")]
+pub enum EdgeName {
+    West,
+    East,
+    South,
+    North,
+}
+
+impl EdgeName {
+    pub fn lattice(self) -> hgym_solvers::lbm::Edge {
+        use hgym_solvers::lbm::Edge;
+        match self {
+            EdgeName::West => Edge::West,
+            EdgeName::East => Edge::East,
+            EdgeName::South => Edge::South,
+            EdgeName::North => Edge::North,
+        }
+    }
+}
+
+/// An absorbing layer (see `hgym_solvers::lbm::sponge`): `thickness` in reference lengths,
+/// `strength` the relaxation per lattice step at the edge (the ramp is quadratic), target the
+/// free stream `(rho, u) = (1, U)`. Used by environment specs (`sponge`) and validation cases
+/// (`[[sponge]]`).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SpongeSpec {
+    pub edge: EdgeName,
+    pub thickness: f64,
+    pub strength: f64,
+}
+
+impl SpongeSpec {
+    /// The solver's layer at `cells_per_length` cells per reference length, free stream at lattice
+    /// speed `u`: at least one node thick.
+    pub fn lattice(&self, cells_per_length: f64, u: f64) -> hgym_solvers::lbm::Sponge {
+        hgym_solvers::lbm::Sponge {
+            edge: self.edge.lattice(),
+            width: ((self.thickness * cells_per_length).round() as usize).max(1),
+            strength: self.strength,
+            rho: 1.0,
+            u: [u, 0.0],
+        }
+    }
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -213,7 +271,8 @@ pub struct FlowSpec {
     /// validation cases leave it at 0; under-resolved runs at Re >= 1000 need about 0.1.
     #[serde(default)]
     pub smagorinsky: f64,
-    /// Amplitude (fraction of U) of a transverse velocity kick near the body at t = 0.
+    /// Amplitude (fraction of U) of a transverse velocity kick near the body at t = 0; a negative
+    /// value is the mirror image of the positive one (it selects the other of two mirror states).
     #[serde(default)]
     pub perturbation: f64,
 }
@@ -253,6 +312,20 @@ pub enum Quantity {
     MeanCl2,
     #[serde(rename = "mean_cl_3")]
     MeanCl3,
+    /// Mean drag of body 1, 2, 3.
+    #[serde(rename = "mean_cd_1")]
+    MeanCd1,
+    #[serde(rename = "mean_cd_2")]
+    MeanCd2,
+    #[serde(rename = "mean_cd_3")]
+    MeanCd3,
+}
+
+/// Which force component a per-body quantity averages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Component {
+    Drag,
+    Lift,
 }
 
 impl Quantity {
@@ -267,15 +340,21 @@ impl Quantity {
             Quantity::MeanCl1 => "mean_cl_1",
             Quantity::MeanCl2 => "mean_cl_2",
             Quantity::MeanCl3 => "mean_cl_3",
+            Quantity::MeanCd1 => "mean_cd_1",
+            Quantity::MeanCd2 => "mean_cd_2",
+            Quantity::MeanCd3 => "mean_cd_3",
         }
     }
 
-    /// The body (0-based) of a per-body quantity.
-    pub fn body(self) -> Option<usize> {
+    /// The body (0-based) and force component of a per-body quantity.
+    pub fn body(self) -> Option<(usize, Component)> {
         match self {
-            Quantity::MeanCl1 => Some(0),
-            Quantity::MeanCl2 => Some(1),
-            Quantity::MeanCl3 => Some(2),
+            Quantity::MeanCl1 => Some((0, Component::Lift)),
+            Quantity::MeanCl2 => Some((1, Component::Lift)),
+            Quantity::MeanCl3 => Some((2, Component::Lift)),
+            Quantity::MeanCd1 => Some((0, Component::Drag)),
+            Quantity::MeanCd2 => Some((1, Component::Drag)),
+            Quantity::MeanCd3 => Some((2, Component::Drag)),
             _ => None,
         }
     }
@@ -443,6 +522,37 @@ impl LoadedCase {
         if c.inlet.ramp < 0.0 || !c.inlet.ramp.is_finite() {
             return Err(bad(name, "inlet.ramp", "must be zero or a positive time"));
         }
+        for (i, sp) in c.sponge.iter().enumerate() {
+            if c.sponge[..i].iter().any(|o| o.edge == sp.edge) {
+                return Err(bad(
+                    name,
+                    "sponge",
+                    format!("two layers on the {:?} edge; give one per edge", sp.edge),
+                ));
+            }
+            if !(sp.thickness.is_finite() && sp.thickness > 0.0) {
+                return Err(bad(
+                    name,
+                    "sponge.thickness",
+                    format!("must be a positive length, got {}", sp.thickness),
+                ));
+            }
+            if !(sp.strength.is_finite() && sp.strength > 0.0 && sp.strength <= 1.0) {
+                return Err(bad(
+                    name,
+                    "sponge.strength",
+                    format!("the relaxation per step at the edge must be in (0, 1], got {}", sp.strength),
+                ));
+            }
+            if c.inlet.ramp > 0.0 {
+                return Err(bad(
+                    name,
+                    "sponge",
+                    "a layer relaxes to the full free stream, which a ramped inlet only reaches at the end of its ramp: \
+                     use one or the other",
+                ));
+            }
+        }
         let t = &c.time;
         if !(t.spin_up.is_finite() && t.spin_up >= 0.0 && t.average.is_finite() && t.average > 0.0) {
             return Err(bad(name, "time", "spin_up must be >= 0 and average > 0"));
@@ -476,7 +586,7 @@ impl LoadedCase {
             }
         }
         for q in &c.measure.quantities {
-            if let Some(b) = q.body() {
+            if let Some((b, _)) = q.body() {
                 if b > c.more_bodies.len() {
                     return Err(bad(
                         name,
@@ -506,6 +616,24 @@ impl LoadedCase {
                         bb[0], bb[2], bb[1], bb[3], d.x[0], d.x[1], d.y[0], d.y[1]
                     ),
                 ));
+            }
+            for sp in &c.sponge {
+                let inside = match sp.edge {
+                    EdgeName::West => bb[0] < d.x[0] + sp.thickness,
+                    EdgeName::East => bb[2] > d.x[1] - sp.thickness,
+                    EdgeName::South => bb[1] < d.y[0] + sp.thickness,
+                    EdgeName::North => bb[3] > d.y[1] - sp.thickness,
+                };
+                if inside {
+                    return Err(bad(
+                        name,
+                        "sponge.thickness",
+                        format!(
+                            "the {:?} layer ({} thick) reaches a body; make it thinner or the domain larger",
+                            sp.edge, sp.thickness
+                        ),
+                    ));
+                }
             }
         }
         Ok(())

@@ -7,7 +7,7 @@ use plotters::style::RGBColor;
 use serde::{Deserialize, Serialize};
 
 use super::analysis::{analyse, spectrum, Analysis};
-use super::case::{LoadedCase, Quantity};
+use super::case::{Component, LoadedCase, Quantity};
 use super::run::{RunOutput, RunStatus};
 use crate::report::manifest::{manifest, Manifest};
 use crate::report::plots;
@@ -93,9 +93,12 @@ fn window_mean(t: &[f64], v: &[f64], w: [f64; 2]) -> Option<f64> {
 }
 
 fn measured(a: &Analysis, q: Quantity, out: &RunOutput) -> Option<f64> {
-    if let Some(b) = q.body() {
-        return out
-            .cl_bodies
+    if let Some((b, component)) = q.body() {
+        let per_body = match component {
+            Component::Drag => &out.cd_bodies,
+            Component::Lift => &out.cl_bodies,
+        };
+        return per_body
             .get(b)
             .and_then(|v| window_mean(&out.t, v, a.window))
             .filter(|v| v.is_finite());
@@ -107,7 +110,7 @@ fn measured(a: &Analysis, q: Quantity, out: &RunOutput) -> Option<f64> {
         Quantity::ClAmplitude => Some(a.cl_amplitude),
         Quantity::ClRms => Some(a.cl_rms),
         Quantity::CdAmplitude => Some(a.cd_amplitude),
-        Quantity::MeanCl1 | Quantity::MeanCl2 | Quantity::MeanCl3 => None,
+        Quantity::MeanCl1 | Quantity::MeanCl2 | Quantity::MeanCl3 | Quantity::MeanCd1 | Quantity::MeanCd2 | Quantity::MeanCd3 => None,
     }
     .filter(|v| v.is_finite())
 }

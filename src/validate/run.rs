@@ -188,7 +188,8 @@ pub struct RunOutput {
     pub t: Vec<f64>,
     pub cd: Vec<f64>,
     pub cl: Vec<f64>,
-    /// Lift of each body (totals are `cl`).
+    /// Drag and lift of each body (totals are `cd`, `cl`).
+    pub cd_bodies: Vec<Vec<f64>>,
     pub cl_bodies: Vec<Vec<f64>>,
     pub vorticity: Field,
     pub status: RunStatus,
@@ -228,6 +229,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     cfg.smagorinsky = case.flow.smagorinsky;
     cfg.grid = grid;
     cfg.check_interval = 200;
+    cfg.sponges = case.sponge.iter().map(|sp| sp.lattice(n, u)).collect();
     let bodies: Vec<_> = std::iter::once(&case.geometry).chain(&case.more_bodies).map(build_shape).collect();
     let n_bodies = bodies.len();
     let mut solver = D2q9::new(cfg, bodies).map_err(|e| match e {
@@ -239,13 +241,17 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
         other => ValidateError::Solver(other.to_string()),
     })?;
 
-    // Initial state: the inflow everywhere, plus a transverse kick just behind the body.
+    // Initial state: the inflow everywhere, plus a transverse kick just behind the body, centred
+    // a quarter length off the axis on the side of its sign: a negative perturbation is the exact
+    // mirror image (y -> -y) of the positive one, so it selects the mirror branch of a flow with
+    // two (a pitchfork bifurcation's asymmetric states).
     let center = case.geometry.center();
     let kick = case.flow.perturbation * u;
+    let side = if case.flow.perturbation < 0.0 { -1.0 } else { 1.0 };
     let ramp = case.inlet.ramp;
     let start_u = if ramp > 0.0 { 0.0 } else { 1.0 };
     solver.init_with(|x, y| {
-        let r2 = ((x - center[0] - l) / l).powi(2) + ((y - center[1] - 0.25 * l) / l).powi(2);
+        let r2 = ((x - center[0] - l) / l).powi(2) + ((y - center[1] - side * 0.25 * l) / l).powi(2);
         (1.0, start_u * inlet_u(y), kick * (-4.0 * r2).exp())
     });
 
@@ -254,6 +260,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     let mut t = Vec::with_capacity(total as usize);
     let mut cd = Vec::with_capacity(total as usize);
     let mut cl = Vec::with_capacity(total as usize);
+    let mut cd_bodies = vec![Vec::with_capacity(total as usize); n_bodies];
     let mut cl_bodies = vec![Vec::with_capacity(total as usize); n_bodies];
     let coef = 0.5 * u * u * n;
     let started = Instant::now();
@@ -285,6 +292,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
         cd.push(forces.iter().map(|f| f[0]).sum::<f64>() / coef);
         cl.push(forces.iter().map(|f| f[1]).sum::<f64>() / coef);
         for (b, f) in forces.iter().enumerate() {
+            cd_bodies[b].push(f[0] / coef);
             cl_bodies[b].push(f[1] / coef);
         }
         if (s + 1) % report_every == 0 {
@@ -301,6 +309,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
         t,
         cd,
         cl,
+        cd_bodies,
         cl_bodies,
         vorticity,
         status,
