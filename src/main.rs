@@ -482,6 +482,35 @@ fn run_bench(json: bool, quick: bool, collision: CollisionArg) -> Result<Outcome
     Ok(if report.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
 }
 
+/// The validation case of the flow behind an environment ID and the status of its report in
+/// `results/validation/` under the working directory (the committed ones when run from the
+/// repository), e.g. `pinball_re100 (pass)`; `-` when no case covers the flow.
+fn validation_status(s: &hgym::env::any::AnySpec) -> String {
+    let base = match s.family() {
+        "cylinder" | "rotary_cylinder" => "cylinder",
+        "pinball" | "jet_pinball" => "pinball",
+        "square_cylinder" => "square",
+        "kolmogorov" => "kolmogorov",
+        _ => return "-".into(),
+    };
+    let name = format!("{base}_re{}", s.reynolds().round() as i64);
+    let bundled = validate::bundled().is_ok_and(|cases| cases.iter().any(|c| c.case.case.name == name));
+    let kolmogorov = hgym::validate::kolmogorov::case().is_ok_and(|c| c.case == name);
+    if !bundled && !kolmogorov {
+        return "-".into();
+    }
+    let report = std::fs::read_to_string(std::path::Path::new("results/validation").join(format!("{name}.json")))
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok());
+    // Flow-case reports carry `status`; the Kolmogorov report a boolean `pass`.
+    let status = report.and_then(|r| match (&r["status"], &r["pass"]) {
+        (serde_json::Value::String(s), _) => Some(s.clone()),
+        (_, serde_json::Value::Bool(p)) => Some(if *p { "pass" } else { "fail" }.to_string()),
+        _ => None,
+    });
+    format!("{name} ({})", status.as_deref().unwrap_or("no report here"))
+}
+
 fn run_envs(args: EnvsArgs) -> Result<Outcome> {
     match args.command {
         None => {
@@ -490,14 +519,7 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
                 hgym::env::any::AnySpec::Lbm(s) => !s.normalization.mean.is_empty(),
                 hgym::env::any::AnySpec::Kolmogorov(s) => s.statistics.u_rms > 0.0,
             };
-            // The committed validation results (results/validation/) of the flow behind each ID.
-            let validation = |s: &hgym::env::any::AnySpec| match s.family() {
-                "cylinder" | "rotary_cylinder" if s.reynolds() <= 1000.0 => "cylinder (pass)",
-                "pinball" | "jet_pinball" if s.reynolds() != 75.0 => "pinball (fail)",
-                "square_cylinder" if s.reynolds() <= 1000.0 => "square (fail)",
-                "kolmogorov" if s.reynolds() <= 40.0 => "kolmogorov (bursts)",
-                _ => "-",
-            };
+            let validation = validation_status;
             if args.json {
                 let rows: Vec<serde_json::Value> = specs
                     .iter()

@@ -155,6 +155,26 @@ fn body_larger_than_the_domain_is_refused() {
     );
 }
 
+/// Runs one case file at the coarse level into `out`; it must pass. Returns its JSON report.
+fn validate_coarse(case: &Path, out: &Path) -> serde_json::Value {
+    let args = [
+        "validate",
+        "--case",
+        case.to_str().unwrap(),
+        "--level",
+        "coarse",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ];
+    let o = hgym(&args);
+    let (stdout, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "stdout: {stdout}\nstderr: {stderr}");
+    let reports: serde_json::Value = serde_json::from_str(&stdout).expect("stdout is JSON");
+    assert_eq!(reports.as_array().map(Vec::len), Some(1), "one report per case");
+    reports[0].clone()
+}
+
 /// The measured value of quantity `q` in a report.
 fn measured(report: &serde_json::Value, q: &str) -> f64 {
     let quantity = report["quantities"].as_array().unwrap().iter().find(|x| x["name"] == q);
@@ -223,21 +243,7 @@ fn absorbing_layers_remove_the_acoustic_ringing_of_the_start() {
         // Keep the case's references out (they are for Re 100): cut everything after the marker.
         let case = case.split("[[ignored]]").next().unwrap().to_string();
         let p = write_case(dir.path(), name, &case);
-        let out = dir.path().join("out");
-        let o = hgym(&[
-            "validate",
-            "--case",
-            p.to_str().unwrap(),
-            "--level",
-            "coarse",
-            "--out",
-            out.to_str().unwrap(),
-            "--json",
-        ]);
-        let (stdout, stderr) = text(&o);
-        assert_eq!(o.status.code(), Some(0), "stdout: {stdout}\nstderr: {stderr}");
-        let reports: serde_json::Value = serde_json::from_str(&stdout).unwrap();
-        reports[0].clone()
+        validate_coarse(&p, &dir.path().join("out"))
     };
     let bare = run("bare", "");
     let layered = run("layered", &sponges(&["west", "east", "south", "north"], 2.0));
@@ -253,26 +259,13 @@ fn absorbing_layers_remove_the_acoustic_ringing_of_the_start() {
 #[test]
 fn pinball_forces_match_hydrogym_firedrake_steady_solution() {
     let dir = tempfile::tempdir().unwrap();
-    let case = repo().join("benchmarks/validation/pinball_re30_steady.toml");
-    let o = hgym(&[
-        "validate",
-        "--case",
-        case.to_str().unwrap(),
-        "--level",
-        "coarse",
-        "--out",
-        dir.path().to_str().unwrap(),
-        "--json",
-    ]);
-    let (stdout, stderr) = text(&o);
-    assert_eq!(o.status.code(), Some(0), "stdout: {stdout}\nstderr: {stderr}");
-    let reports: serde_json::Value = serde_json::from_str(&stdout).unwrap();
-    let value = |q: &str| measured(&reports[0], q);
+    let report = validate_coarse(&repo().join("benchmarks/validation/pinball_re30_steady.toml"), dir.path());
+    let value = |q: &str| measured(&report, q);
     // The mirror-symmetric grid keeps the unstable symmetric state: equal rear drags, opposite lifts.
     assert!((value("mean_cd_2") - value("mean_cd_3")).abs() < 1e-4);
     assert!((value("mean_cl_2") + value("mean_cl_3")).abs() < 1e-4);
     assert!(value("mean_cl_1").abs() < 1e-3);
-    schema_check(&reports[0]);
+    schema_check(&report);
 }
 
 #[test]
@@ -366,24 +359,7 @@ fn committed_validation_reports_match_the_schema() {
 fn json_output_is_machine_readable() {
     let dir = tempfile::tempdir().unwrap();
     let case = repo().join("tests/cases/schaefer_turek_2d1.toml");
-    let out = dir.path().join("out");
-    let o = hgym(&[
-        "validate",
-        "--case",
-        case.to_str().unwrap(),
-        "--level",
-        "coarse",
-        "--out",
-        out.to_str().unwrap(),
-        "--json",
-        "--threads",
-        "1",
-    ]);
-    assert_eq!(o.status.code(), Some(0));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("stdout is JSON");
-    let arr = v.as_array().unwrap();
-    assert_eq!(arr.len(), 1);
-    schema_check(&arr[0]);
+    schema_check(&validate_coarse(&case, &dir.path().join("out")));
 }
 
 #[test]
@@ -410,6 +386,9 @@ fn envs_lists_every_id_and_show_round_trips() {
     for spec in hgym::env::registry::all() {
         assert!(out.contains(&spec.id), "{} missing from `hgym envs`", spec.id);
     }
+    // The validation column reads the committed reports (tests run in the repository).
+    let row = out.lines().find(|l| l.starts_with("Cylinder_2D_Re100 ")).unwrap();
+    assert!(row.ends_with("cylinder_re100 (pass)"), "{row}");
     let o = hgym(&["envs", "show", "Cylinder_2D_Re200"]);
     assert!(o.status.success());
     let shown: hgym::env::EnvSpec = toml::from_str(&text(&o).0).expect("`envs show` prints valid TOML");
