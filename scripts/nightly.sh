@@ -20,6 +20,7 @@ step() {
 }
 step validate-cylinder "$HGYM" validate cylinder --level default
 step validate-pinball  "$HGYM" validate pinball --level default
+step validate-square   "$HGYM" validate square --level default
 step validate-kolmogorov "$HGYM" validate kolmogorov
 step bench-lbm        "$HGYM" bench lbm
 step bench-agents     "$HGYM" bench agents

@@ -76,3 +76,29 @@ fn every_result_json_matches_its_schema() {
     }
     println!("validated {} files: {counts:?}", files.len());
 }
+
+/// Every bundled validation case has a committed report in `results/validation/`, produced from
+/// the case file as it is now (same SHA-256) at the default level: editing a case without
+/// re-running it, or committing a coarse run, fails here.
+#[test]
+fn committed_validation_reports_come_from_the_current_case_files() {
+    let cases = hgym::validate::bundled().expect("bundled cases parse");
+    assert!(cases.len() >= 9, "expected the bundled cases, found {}", cases.len());
+    let mut stale = vec![];
+    for c in &cases {
+        let name = &c.case.case.name;
+        let path = repo().join("results/validation").join(format!("{name}.json"));
+        let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let report: serde_json::Value = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        if report["case_hash"].as_str() != Some(c.hash.as_str()) {
+            stale.push(format!("{name}: report from case {}, file is {}", report["case_hash"], c.hash));
+        }
+        if report["level"].as_str() != Some("default") {
+            stale.push(format!("{name}: report at level {}, not default", report["level"]));
+        }
+    }
+    assert!(
+        stale.is_empty(),
+        "re-run `hgym validate --case benchmarks/validation/<name>.toml`: {stale:#?}"
+    );
+}
