@@ -155,9 +155,9 @@ fn body_larger_than_the_domain_is_refused() {
     );
 }
 
-/// Runs one case file at the coarse level into `out`; it must pass. Returns its JSON report.
-fn validate_coarse(case: &Path, out: &Path) -> serde_json::Value {
-    let args = [
+/// `hgym validate --case CASE --level coarse --out OUT` (with `--json` when asked).
+fn run_coarse(case: &Path, out: &Path, json: bool) -> std::process::Output {
+    let mut args = vec![
         "validate",
         "--case",
         case.to_str().unwrap(),
@@ -165,9 +165,16 @@ fn validate_coarse(case: &Path, out: &Path) -> serde_json::Value {
         "coarse",
         "--out",
         out.to_str().unwrap(),
-        "--json",
     ];
-    let o = hgym(&args);
+    if json {
+        args.push("--json");
+    }
+    hgym(&args)
+}
+
+/// Runs one case file at the coarse level into `out`; it must pass. Returns its JSON report.
+fn validate_coarse(case: &Path, out: &Path) -> serde_json::Value {
+    let o = run_coarse(case, out, true);
     let (stdout, stderr) = text(&o);
     assert_eq!(o.status.code(), Some(0), "stdout: {stdout}\nstderr: {stderr}");
     let reports: serde_json::Value = serde_json::from_str(&stdout).expect("stdout is JSON");
@@ -201,15 +208,7 @@ fn bad_absorbing_layers_are_refused_naming_the_problem() {
     ] {
         let case = format!("{}\n{layers}", small_case(&[]));
         let p = write_case(dir.path(), name, &case);
-        let o = hgym(&[
-            "validate",
-            "--case",
-            p.to_str().unwrap(),
-            "--level",
-            "coarse",
-            "--out",
-            dir.path().to_str().unwrap(),
-        ]);
+        let o = run_coarse(&p, dir.path(), false);
         assert_eq!(o.status.code(), Some(2), "{name}");
         let (_, err) = text(&o);
         assert!(err.contains(expect), "{name}: {err}");
@@ -283,15 +282,7 @@ fn blow_up_exits_1_naming_step_and_cause_with_plots_written() {
     ]);
     let p = write_case(dir.path(), "blowup", &case);
     let out = dir.path().join("out");
-    let o = hgym(&[
-        "validate",
-        "--case",
-        p.to_str().unwrap(),
-        "--level",
-        "coarse",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = run_coarse(&p, &out, false);
     let (stdout, stderr) = text(&o);
     assert_eq!(o.status.code(), Some(1), "stdout: {stdout}\nstderr: {stderr}");
     assert!(stdout.contains("DIVERGED") && stdout.contains("diverged at step"), "{stdout}");
@@ -308,15 +299,7 @@ fn an_unseen_case_file_runs_and_passes() {
     let dir = tempfile::tempdir().unwrap();
     let case = repo().join("tests/cases/schaefer_turek_2d1.toml");
     let out = dir.path().join("out");
-    let o = hgym(&[
-        "validate",
-        "--case",
-        case.to_str().unwrap(),
-        "--level",
-        "coarse",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = run_coarse(&case, &out, false);
     let (stdout, stderr) = text(&o);
     println!("{stdout}");
     assert_eq!(o.status.code(), Some(0), "stdout: {stdout}\nstderr: {stderr}");
