@@ -2,17 +2,16 @@
 //! outcome to an exit code: 0 ok, 1 a check failed (validation out of tolerance, solver
 //! diverged, benchmark short of its target), 2 bad usage or bad input.
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
-use indicatif::{ProgressBar, ProgressStyle};
 
 use hgym::bench::{bench_lbm, LbmBenchOptions};
 
 mod cli;
+use cli::progress::{progress_bar, Progress};
 use hgym::validate::{self, Level, LoadedCase, Options, Status, ValidateError};
 
 #[derive(Parser)]
@@ -271,6 +270,7 @@ fn main() -> ExitCode {
             return ExitCode::from(code);
         }
     };
+    hgym::env::spin_up::observe_spin_ups(cli::progress::spin_up_progress);
     let result = match cli.command {
         Command::Validate(args) => run_validate(args),
         Command::Bench(BenchCommand::Lbm { json, quick, collision }) => run_bench(json, quick, collision),
@@ -366,24 +366,11 @@ fn thread_pool(threads: Option<usize>) -> Result<(rayon::ThreadPool, usize)> {
     Ok((pool, n))
 }
 
-fn progress_bar(total: u64, label: &str) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let pb = ProgressBar::new(total);
-    let style = ProgressStyle::with_template("{msg:>16} [{bar:40.cyan/blue}] {pos}/{len} steps, {per_sec}, eta {eta}")
-        .unwrap_or_else(|_| ProgressStyle::default_bar())
-        .progress_chars("=> ");
-    pb.set_style(style);
-    pb.set_message(label.to_string());
-    pb
-}
-
 fn run_validate(args: ValidateArgs) -> Result<Outcome> {
     if args.family.as_deref() == Some("kolmogorov") {
         let (pool, _) = thread_pool(args.threads)?;
         let case = hgym::validate::kolmogorov::case().map_err(UsageError)?;
-        let pb = progress_bar((case.time / case.sample_interval) as u64, "kolmogorov Re 40");
+        let pb = Progress::new((case.time / case.sample_interval) as u64, "kolmogorov Re 40");
         let r = pool
             .install(|| hgym::validate::kolmogorov::validate(args.level, &args.out, &mut |k, _| pb.set_position(k as u64)))
             .context("Kolmogorov validation")?;
@@ -434,7 +421,7 @@ fn run_validate(args: ValidateArgs) -> Result<Outcome> {
     let mut reports = Vec::new();
     for c in &cases {
         let plan = validate::plan(c, args.level)?;
-        let pb = progress_bar(plan.total_steps, &c.case.case.name);
+        let pb = Progress::new(plan.total_steps, &c.case.case.name);
         let report = pool
             .install(|| validate::validate_case(c, &opts, &mut |done, _| pb.set_position(done)))
             .with_context(|| format!("validation case '{}'", c.case.case.name))?;
@@ -575,7 +562,7 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
                 .with_context(|| format!("cannot read {} (run from the repository root)", table.display()))?;
             let mut entries: std::collections::BTreeMap<String, hgym::env::kolmogorov::FlowStatistics> =
                 toml::from_str(&text).with_context(|| format!("{} is malformed", table.display()))?;
-            let pb = progress_bar(actions as u64, &id);
+            let pb = Progress::new(actions as u64, &id);
             let st = hgym::env::kolmogorov::calibrate(&spec, level, actions, &mut |k| pb.set_position(k as u64))
                 .with_context(|| format!("calibrating {id}"))?;
             pb.finish_and_clear();
@@ -611,7 +598,7 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
             // Parsed now to fail fast on a broken table; read again before writing (below).
             hgym::env::calibrate::parse_table(&text).map_err(anyhow::Error::msg)?;
             let (pool, _) = thread_pool(threads)?;
-            let pb = progress_bar(actions as u64, &id);
+            let pb = Progress::new(actions as u64, &id);
             let entry = pool
                 .install(|| {
                     hgym::env::calibrate::calibrate(&spec, level, actions, hgym::env::default_cache_dir(), &mut |k, _| {
@@ -687,7 +674,7 @@ fn run_rollout(args: RunArgs) -> Result<Outcome> {
         "{}: starting from the developed flow (spun up once per ID and level, then cached)",
         spec.id
     );
-    let pb = progress_bar(args.steps as u64, &spec.id);
+    let pb = Progress::new(args.steps as u64, &spec.id);
     cli::train::install_interrupt();
     let summary = pool
         .install(|| {

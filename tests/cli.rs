@@ -304,6 +304,13 @@ fn an_unseen_case_file_runs_and_passes() {
     println!("{stdout}");
     assert_eq!(o.status.code(), Some(0), "stdout: {stdout}\nstderr: {stderr}");
     assert!(stdout.contains("mean_cd") && stdout.contains("PASS"));
+    // stderr is a pipe here, as in a log file: progress comes as a line per tenth of the run.
+    let tenths: Vec<&str> = stderr.lines().filter(|l| l.starts_with("schaefer_turek_2d1: ")).collect();
+    assert_eq!(tenths.len(), 10, "{stderr}");
+    assert!(
+        tenths[0].starts_with("schaefer_turek_2d1: 10% (") && tenths[9].contains("100% ("),
+        "{stderr}"
+    );
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("schaefer_turek_2d1.json")).unwrap()).unwrap();
     schema_check(&report);
     assert_eq!(report["status"], "pass");
@@ -398,27 +405,37 @@ fn unknown_env_id_exits_2_with_suggestions() {
 fn run_writes_metrics_plots_and_manifest() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("runs");
-    let o = Command::new(env!("CARGO_BIN_EXE_hgym"))
-        .args([
-            "run",
-            "--env",
-            "RotaryCylinder_2D_Re100",
-            "--policy",
-            "random",
-            "--steps",
-            "5",
-            "--res",
-            "coarse",
-            "--seed",
-            "3",
-        ])
-        .arg("--out")
-        .arg(&out)
-        .env("HGYM_CACHE", dir.path().join("cache"))
-        .output()
-        .unwrap();
+    let run = || {
+        Command::new(env!("CARGO_BIN_EXE_hgym"))
+            .args([
+                "run",
+                "--env",
+                "RotaryCylinder_2D_Re100",
+                "--policy",
+                "random",
+                "--steps",
+                "5",
+                "--res",
+                "coarse",
+                "--seed",
+                "3",
+            ])
+            .arg("--out")
+            .arg(&out)
+            .env("HGYM_CACHE", dir.path().join("cache"))
+            .output()
+            .unwrap()
+    };
+    let o = run();
     let (stdout, stderr) = text(&o);
     assert!(o.status.success(), "{stdout}\n{stderr}");
+    // The first reset spins the flow up; stderr is a pipe, so it reports a line per tenth.
+    let spin_up: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.starts_with("spin-up of RotaryCylinder_2D_Re100: "))
+        .collect();
+    assert_eq!(spin_up.len(), 10, "{stderr}");
+    assert!(spin_up[9].contains(": 100% ("), "{stderr}");
     let folder = out.join("RotaryCylinder_2D_Re100-random-seed3");
     for f in ["manifest.json", "metrics.json", "rollout.png", "vorticity.png"] {
         assert!(folder.join(f).exists(), "{f} missing");
@@ -427,6 +444,10 @@ fn run_writes_metrics_plots_and_manifest() {
     assert_eq!(m["actions_run"], 5);
     assert_eq!(m["truncated"], true);
     assert_eq!(m["spec_hash"].as_str().unwrap().len(), 64);
-    // The developed flow was cached for the next run.
+    // The developed flow was cached for the next run, which does not spin up again.
     assert!(std::fs::read_dir(dir.path().join("cache")).unwrap().count() >= 1);
+    let o = run();
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stdout}\n{stderr}");
+    assert!(!stderr.contains("spin-up"), "{stderr}");
 }

@@ -51,7 +51,7 @@ pub fn run_export(args: ExportArgs) -> Result<Outcome> {
         ..ExportOptions::default()
     };
     let paths = hgym::data::hf::find_trajectories(&args.dir).map_err(UsageError)?;
-    let pb = crate::progress_bar(paths.len() as u64, "reading");
+    let pb = crate::Progress::new(paths.len() as u64, "reading");
     let report = export(&args.dir, &args.out, &opts, &mut |k, _| pb.set_position(k as u64)).map_err(UsageError)?;
     pb.finish_and_clear();
     if args.json {

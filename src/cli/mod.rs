@@ -1,6 +1,7 @@
 //! Subcommands of the binary that grew past a few lines: `train`, `eval`, `bench agents`;
-//! `export`, `push`.
+//! `export`, `push`; progress reports for long runs.
 
 pub mod data;
+pub mod progress;
 
 pub mod train;

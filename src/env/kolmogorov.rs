@@ -273,13 +273,11 @@ impl KolmogorovEnv {
         self.solver.set_vorticity(&kick);
         let w: Vec<C> = self.solver.omega.iter().zip(&lam).map(|(a, b)| *a + *b).collect();
         self.solver.omega = w;
-        let steps = (self.spec.spin_up / self.spec.dt(self.level)).round() as usize;
+        let steps = (self.spec.spin_up / self.spec.dt(self.level)).round() as u64;
         let zero = vec![0.0; self.spec.act_dim()];
-        for _ in 0..steps {
-            self.solver
-                .step(&zero)
-                .map_err(|e| EnvError::Backend(format!("{}: spin-up failed: {e}", self.spec.id)))?;
-        }
+        let id = self.spec.id.clone();
+        super::spin_up::run_reported(&id, steps, |n| (0..n).try_for_each(|_| self.solver.step(&zero)))
+            .map_err(|e| EnvError::Backend(format!("{}: spin-up failed: {e}", self.spec.id)))?;
         let w = self.solver.omega.clone();
         if let Ok(mut m) = attractors().lock() {
             m.insert(key, w.clone());

@@ -389,7 +389,8 @@ impl LbmEnv {
         self.actuate(&rest);
         self.noise_seed = 0;
         let steps = self.units.steps(self.spec.spin_up);
-        self.advance(steps)
+        let id = self.spec.id.clone();
+        super::spin_up::run_reported(&id, steps, |n| self.advance(n))
             .map_err(|e| EnvError::Backend(format!("{}: spin-up diverged: {e}", self.spec.id)))?;
         let mut state = self.solver.populations().to_vec();
         if let Some(th) = &self.thermal {

@@ -4,7 +4,8 @@
 //! - [`registry`]: every ID; [`cylinder`], [`pinball`], [`square`], [`cavity`], [`naca`],
 //!   [`pipe`]: the families' specs;
 //! - [`lbm_env`]: the `Env` implementation for 2D lattice-Boltzmann families;
-//! - [`actuation`]: jets, rotation, and the temporal smoothing of actions.
+//! - [`actuation`]: jets, rotation, and the temporal smoothing of actions;
+//! - [`spin_up`]: progress reports of the first reset's spin-up, to an observer the program installs.
 
 pub mod actuation;
 pub mod any;
@@ -21,6 +22,7 @@ pub mod registry;
 pub mod rollout;
 mod seeding;
 pub mod spec;
+pub mod spin_up;
 pub mod square;
 
 pub use lbm_env::LbmEnv;

@@ -1,0 +1,88 @@
+//! Telling someone how a spin-up is going.
+//!
+//! The first reset of an ID runs the flow from rest onto its attractor before it is cached, which
+//! takes from seconds to about ten minutes (the cavity at its default level). The library draws
+//! nothing itself; a program installs one observer for the whole process (the `hgym` binary a
+//! progress bar), and every spin-up reports to it in up to [`REPORTS`] chunks.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::OnceLock;
+
+/// One report: which spin-up (a serial number, distinct for spin-ups running at the same time),
+/// the environment ID, solver steps done, solver steps in all. `done == 0` opens a spin-up and
+/// `done == total` closes it.
+pub type SpinUpObserver = fn(serial: u64, id: &str, done: u64, total: u64);
+
+/// How many reports a spin-up makes after its opening one, at most.
+pub const REPORTS: u64 = 100;
+
+static OBSERVER: OnceLock<SpinUpObserver> = OnceLock::new();
+static SERIAL: AtomicU64 = AtomicU64::new(0);
+
+/// Installs the process's observer; only the first call has an effect.
+pub fn observe_spin_ups(observer: SpinUpObserver) {
+    let _ = OBSERVER.set(observer);
+}
+
+/// Runs `total` solver steps through `advance(n)` in up to [`REPORTS`] chunks, reporting after
+/// each; stops at the first error. The chunks change nothing in the result: the solver is
+/// stepped `total` times either way.
+pub(crate) fn run_reported<E>(id: &str, total: u64, mut advance: impl FnMut(u64) -> Result<(), E>) -> Result<(), E> {
+    let observer = OBSERVER.get();
+    let serial = SERIAL.fetch_add(1, Ordering::Relaxed);
+    let Some(observer) = observer else {
+        return advance(total);
+    };
+    observer(serial, id, 0, total);
+    let chunk = total.div_ceil(REPORTS).max(1);
+    let mut done = 0;
+    while done < total {
+        let n = chunk.min(total - done);
+        advance(n)?;
+        done += n;
+        observer(serial, id, done, total);
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::Mutex;
+
+    static SEEN: Mutex<Vec<(u64, u64)>> = Mutex::new(Vec::new());
+
+    fn record(_: u64, id: &str, done: u64, total: u64) {
+        if id == "test-id" {
+            SEEN.lock().unwrap().push((done, total));
+        }
+    }
+
+    #[test]
+    fn every_step_is_run_once_and_reported_in_order() {
+        observe_spin_ups(record);
+        let mut stepped = 0u64;
+        run_reported::<()>("test-id", 1234, |n| {
+            stepped += n;
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(stepped, 1234);
+        let seen = SEEN.lock().unwrap().clone();
+        assert_eq!(seen.first(), Some(&(0, 1234)));
+        assert_eq!(seen.last(), Some(&(1234, 1234)));
+        assert!(seen.len() <= REPORTS as usize + 1);
+        assert!(seen.windows(2).all(|w| w[0].0 < w[1].0), "{seen:?}");
+        // An error stops the run and is passed on.
+        let mut calls = 0;
+        let r = run_reported("other", 500, |_| {
+            calls += 1;
+            if calls == 3 {
+                Err("diverged")
+            } else {
+                Ok(())
+            }
+        });
+        assert_eq!((r, calls), (Err("diverged"), 3));
+    }
+}
