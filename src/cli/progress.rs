@@ -54,7 +54,8 @@ impl Progress {
 }
 
 /// Shows a first reset's spin-up (an observer for [`hgym::env::spin_up`]): one bar or log at a
-/// time; reports of a spin-up that starts while another is shown are left out.
+/// time; reports of a spin-up that starts while another is shown are left out. A spin-up that
+/// stopped early (`total == 0`) is cleared without a line: its error follows.
 pub fn spin_up_progress(serial: u64, id: &str, done: u64, total: u64) {
     static SHOWN: Mutex<Option<(u64, Progress)>> = Mutex::new(None);
     let Ok(mut shown) = SHOWN.lock() else {
@@ -65,7 +66,9 @@ pub fn spin_up_progress(serial: u64, id: &str, done: u64, total: u64) {
     }
     if let Some((s, pb)) = shown.as_ref() {
         if *s == serial {
-            pb.set_position(done);
+            if total > 0 {
+                pb.set_position(done);
+            }
             if done >= total {
                 pb.finish_and_clear();
                 *shown = None;

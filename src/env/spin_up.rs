@@ -10,7 +10,7 @@ use std::sync::OnceLock;
 
 /// One report: which spin-up (a serial number, distinct for spin-ups running at the same time),
 /// the environment ID, solver steps done, solver steps in all. `done == 0` opens a spin-up and
-/// `done == total` closes it.
+/// `done == total` closes it; a spin-up stopped by an error closes with `total == 0`.
 pub type SpinUpObserver = fn(serial: u64, id: &str, done: u64, total: u64);
 
 /// How many reports a spin-up makes after its opening one, at most.
@@ -38,7 +38,10 @@ pub(crate) fn run_reported<E>(id: &str, total: u64, mut advance: impl FnMut(u64)
     let mut done = 0;
     while done < total {
         let n = chunk.min(total - done);
-        advance(n)?;
+        if let Err(e) = advance(n) {
+            observer(serial, id, done, 0);
+            return Err(e);
+        }
         done += n;
         observer(serial, id, done, total);
     }
@@ -53,7 +56,7 @@ mod tests {
     static SEEN: Mutex<Vec<(u64, u64)>> = Mutex::new(Vec::new());
 
     fn record(_: u64, id: &str, done: u64, total: u64) {
-        if id == "test-id" {
+        if id.starts_with("test-") {
             SEEN.lock().unwrap().push((done, total));
         }
     }
@@ -73,9 +76,10 @@ mod tests {
         assert_eq!(seen.last(), Some(&(1234, 1234)));
         assert!(seen.len() <= REPORTS as usize + 1);
         assert!(seen.windows(2).all(|w| w[0].0 < w[1].0), "{seen:?}");
-        // An error stops the run and is passed on.
+        // An error stops the run, is passed on, and closes the spin-up with total 0.
+        SEEN.lock().unwrap().clear();
         let mut calls = 0;
-        let r = run_reported("other", 500, |_| {
+        let r = run_reported("test-error", 500, |_| {
             calls += 1;
             if calls == 3 {
                 Err("diverged")
@@ -84,5 +88,6 @@ mod tests {
             }
         });
         assert_eq!((r, calls), (Err("diverged"), 3));
+        assert_eq!(SEEN.lock().unwrap().last(), Some(&(10, 0)), "5 steps a chunk, 2 chunks done");
     }
 }
