@@ -11,7 +11,7 @@ use clap::{Args, Parser, Subcommand};
 use hgym::bench::{bench_lbm, LbmBenchOptions};
 
 mod cli;
-use cli::progress::{progress_bar, Progress};
+use cli::progress::Progress;
 use hgym::validate::{self, Level, LoadedCase, Options, Status, ValidateError};
 
 #[derive(Parser)]

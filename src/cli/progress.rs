@@ -16,6 +16,10 @@ pub fn progress_bar(total: u64, label: &str) -> ProgressBar {
     if !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
+    styled_bar(total, label)
+}
+
+fn styled_bar(total: u64, label: &str) -> ProgressBar {
     let pb = ProgressBar::new(total);
     let style = ProgressStyle::with_template("{msg:>16} [{bar:40.cyan/blue}] {pos}/{len} steps, {per_sec}, eta {eta}")
         .unwrap_or_else(|_| ProgressStyle::default_bar())
@@ -33,10 +37,16 @@ pub struct Progress {
 
 impl Progress {
     pub fn new(total: u64, label: &str) -> Self {
-        let log = (!std::io::stderr().is_terminal()).then(|| TenthsLog::new(total, label));
-        Progress {
-            bar: progress_bar(total, label),
-            log,
+        if std::io::stderr().is_terminal() {
+            Progress {
+                bar: styled_bar(total, label),
+                log: None,
+            }
+        } else {
+            Progress {
+                bar: ProgressBar::hidden(),
+                log: Some(TenthsLog::new(total, label)),
+            }
         }
     }
 

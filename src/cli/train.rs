@@ -13,7 +13,8 @@ use hgym_agents::baselines::BaselinePolicy;
 use hgym_agents::learn::Algo;
 use hgym_agents::policy::Policy;
 
-use crate::{progress_bar, thread_pool, Outcome, UsageError};
+use crate::cli::progress::progress_bar;
+use crate::{thread_pool, Outcome, UsageError};
 
 #[derive(Clone, Copy, clap::ValueEnum)]
 pub enum AlgoArg {
