@@ -233,6 +233,9 @@ enum BenchCommand {
         /// Only the coarse level (fast smoke run).
         #[arg(long)]
         quick: bool,
+        /// Only this family (repeatable), e.g. `--family stenotic_pipe`; an unknown name lists the families.
+        #[arg(long)]
+        family: Vec<String>,
     },
 }
 
@@ -274,7 +277,12 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Validate(args) => run_validate(args),
         Command::Bench(BenchCommand::Lbm { json, quick, collision }) => run_bench(json, quick, collision),
-        Command::Bench(BenchCommand::Envs { json, actions, quick }) => run_bench_envs(json, actions, quick),
+        Command::Bench(BenchCommand::Envs {
+            json,
+            actions,
+            quick,
+            family,
+        }) => run_bench_envs(json, actions, quick, &family),
         Command::Envs(args) => run_envs(args),
         Command::Run(args) => run_rollout(args),
         Command::Train(args) => cli::train::run_train(args),
@@ -704,16 +712,20 @@ fn run_rollout(args: RunArgs) -> Result<Outcome> {
     Ok(if summary.terminated { Outcome::CheckFailed } else { Outcome::Ok })
 }
 
-fn run_bench_envs(json: bool, actions: usize, quick: bool) -> Result<Outcome> {
+fn run_bench_envs(json: bool, actions: usize, quick: bool, families: &[String]) -> Result<Outcome> {
     if actions == 0 {
         return Err(UsageError("--actions must be at least 1".into()).into());
+    }
+    let known = hgym::bench::envs::families();
+    if let Some(f) = families.iter().find(|f| !known.contains(f)) {
+        return Err(UsageError(format!("unknown family '{f}'; the families are: {}", known.join(", "))).into());
     }
     let levels: &[Level] = if quick {
         &[Level::Coarse]
     } else {
         &[Level::Coarse, Level::Default]
     };
-    let rows = hgym::bench::envs::bench_envs(levels, actions, hgym::env::default_cache_dir(), &mut |m| {
+    let rows = hgym::bench::envs::bench_envs(levels, actions, families, hgym::env::default_cache_dir(), &mut |m| {
         if !json {
             eprintln!("{m}");
         }

@@ -369,6 +369,29 @@ fn bench_quick_reports_mlups_and_roofline_fraction() {
 }
 
 #[test]
+fn bench_envs_times_only_the_families_asked_for() {
+    let o = hgym(&["bench", "envs", "--family", "pinbal"]);
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("unknown family 'pinbal'") && err.contains("stenotic_pipe"), "{err}");
+
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_hgym"))
+        .args(["bench", "envs", "--family", "stenotic_pipe", "--quick", "--actions", "2", "--json"])
+        .env("HGYM_CACHE", dir.path())
+        .output()
+        .unwrap();
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let rows: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let rows = rows.as_array().unwrap();
+    assert_eq!(rows.len(), 1, "{out}");
+    assert_eq!(rows[0]["family"], "stenotic_pipe");
+    assert_eq!(rows[0]["level"], "coarse");
+    assert!(rows[0]["actions_per_s"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
 fn envs_lists_every_id_and_show_round_trips() {
     let o = hgym(&["envs"]);
     assert!(o.status.success());

@@ -21,16 +21,27 @@ pub struct EnvBenchRow {
     pub mlups: f64,
 }
 
-/// Times `actions` random-sign actions on one ID per family at each level.
+/// The lattice-Boltzmann families `bench_envs` can time, sorted.
+pub fn families() -> Vec<String> {
+    let set: std::collections::BTreeSet<String> = registry::all().into_iter().map(|s| s.family).collect();
+    set.into_iter().collect()
+}
+
+/// Times `actions` random-sign actions on one ID per family at each level; `families` limits
+/// the run to those families (all when empty; see [`families`]).
 pub fn bench_envs(
     levels: &[Level],
     actions: usize,
+    families: &[String],
     cache: Option<std::path::PathBuf>,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Vec<EnvBenchRow>, String> {
     let mut seen = std::collections::BTreeSet::new();
     let mut rows = Vec::new();
     for spec in registry::all() {
+        if !families.is_empty() && !families.contains(&spec.family) {
+            continue;
+        }
         if !seen.insert(spec.family.clone()) {
             continue;
         }

@@ -589,7 +589,13 @@ impl D2q9 {
         for (i, gi) in g.iter_mut().enumerate() {
             *gi = self.f[(y * Q + i) * nx + x];
         }
-        let (drho, jx, jy) = moments(&g);
+        self.density_velocity(&g)
+    }
+
+    /// Density and (half-force-corrected) velocity of one node's shifted populations.
+    #[inline(always)]
+    fn density_velocity(&self, g: &[f32; Q]) -> (f32, f32, f32) {
+        let (drho, jx, jy) = moments(g);
         let rho = 1.0 + drho;
         let (fx, fy) = (self.cfg.body_force[0] as f32, self.cfg.body_force[1] as f32);
         (rho, (jx + 0.5 * fx) / rho, (jy + 0.5 * fy) / rho)
@@ -605,8 +611,11 @@ impl D2q9 {
             .take(self.cfg.ny)
             .enumerate()
             .for_each(|(y, ((r, u), v))| {
+                // Row `y` holds the nine direction rows one after another.
+                let rows = &self.f[y * Q * nx..(y + 1) * Q * nx];
                 for x in 0..nx.min(r.len()) {
-                    (r[x], u[x], v[x]) = self.node(x, y);
+                    let g: [f32; Q] = std::array::from_fn(|i| rows[i * nx + x]);
+                    (r[x], u[x], v[x]) = self.density_velocity(&g);
                 }
             });
     }
