@@ -95,12 +95,9 @@ impl StepCtx<'_> {
                 continue;
             }
             if !self.solid[c] {
-                let p = self.pull_at_boundary(x, y);
-                let t: f32 = p.iter().sum();
-                let (u, v) = (self.ux[c], self.uy[c]);
-                for (i, pi) in p.iter().enumerate() {
-                    let eq = W5[i] * t * (1.0 + 3.0 * (CX5[i] as f32 * u + CY5[i] as f32 * v));
-                    out[i][x] = pi - self.omega * (pi - eq);
+                let post = collide(self.pull_at_boundary(x, y), self.ux[c], self.uy[c], self.omega);
+                for (o, p) in out.iter_mut().zip(post) {
+                    o[x] = p;
                 }
             }
             x += 1;
@@ -109,8 +106,7 @@ impl StepCtx<'_> {
 
     /// Nodes `x0..x1` of row `y`, all with four fluid neighbours inside the domain: plain pull
     /// streaming `p_i = g_i(x - c_i)` and the collision, in a loop without branches that the
-    /// compiler vectorises. Same arithmetic as the boundary path (`c_i . u` is `+-u`, `+-v` or 0
-    /// exactly), so the two agree bitwise.
+    /// compiler vectorises.
     fn bulk_run(&self, y: usize, x0: usize, x1: usize, out: &mut [&mut [f32]; Q5]) {
         let (nx, g) = (self.nx, self.g);
         let n = nx * self.ny;
@@ -124,23 +120,9 @@ impl StepCtx<'_> {
         let [o0, o1, o2, o3, o4] = out;
         let (o0, o1, o2) = (&mut o0[x0..x1], &mut o1[x0..x1], &mut o2[x0..x1]);
         let (o3, o4) = (&mut o3[x0..x1], &mut o4[x0..x1]);
-        let w = self.omega;
         for k in 0..len {
-            let p = [s0[k], s1[k], s2[k], s3[k], s4[k]];
-            let t: f32 = p.iter().sum();
-            let (u3, v3) = (3.0 * ux[k], 3.0 * uy[k]);
-            let eq = [
-                W5[0] * t,
-                W5[1] * t * (1.0 + u3),
-                W5[2] * t * (1.0 + v3),
-                W5[3] * t * (1.0 - u3),
-                W5[4] * t * (1.0 - v3),
-            ];
-            o0[k] = p[0] - w * (p[0] - eq[0]);
-            o1[k] = p[1] - w * (p[1] - eq[1]);
-            o2[k] = p[2] - w * (p[2] - eq[2]);
-            o3[k] = p[3] - w * (p[3] - eq[3]);
-            o4[k] = p[4] - w * (p[4] - eq[4]);
+            let p = collide([s0[k], s1[k], s2[k], s3[k], s4[k]], ux[k], uy[k], self.omega);
+            (o0[k], o1[k], o2[k], o3[k], o4[k]) = (p[0], p[1], p[2], p[3], p[4]);
         }
     }
 
@@ -180,6 +162,23 @@ impl StepCtx<'_> {
         }
         p
     }
+}
+
+/// BGK collision of one node's arriving populations `p` with the flow velocity `(u, v)`:
+/// `p_i - omega (p_i - w_i T (1 + 3 c_i . u))`, `T = sum p_i` (`c_i . u` written out as `+-u`,
+/// `+-v` or nothing for the D2Q5 directions 0 rest, 1 E, 2 N, 3 W, 4 S).
+#[inline(always)]
+fn collide(p: [f32; Q5], u: f32, v: f32, omega: f32) -> [f32; Q5] {
+    let t: f32 = p.iter().sum();
+    let (u3, v3) = (3.0 * u, 3.0 * v);
+    let eq = [
+        W5[0] * t,
+        W5[1] * t * (1.0 + u3),
+        W5[2] * t * (1.0 + v3),
+        W5[3] * t * (1.0 - u3),
+        W5[4] * t * (1.0 - v3),
+    ];
+    std::array::from_fn(|i| p[i] - omega * (p[i] - eq[i]))
 }
 
 /// Marks the nodes whose four D2Q5 neighbours are all fluid nodes inside the domain: there the
