@@ -216,6 +216,11 @@ impl LbmEnv {
         &self.solver
     }
 
+    /// The temperature field, for specs with a `[thermal]` section.
+    pub fn thermal(&self) -> Option<&Thermal> {
+        self.thermal.as_ref()
+    }
+
     /// Lattice <-> non-dimensional units at this env's level.
     pub fn units(&self) -> &Units {
         &self.units
