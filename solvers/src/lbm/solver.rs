@@ -592,6 +592,21 @@ impl D2q9 {
         self.density_velocity(&g)
     }
 
+    /// The nine shifted post-collision populations `g_i = f_i* - w_i` of node `(x, y)`.
+    pub fn node_populations(&self, x: usize, y: usize) -> [f32; Q] {
+        let nx = self.cfg.nx;
+        std::array::from_fn(|i| self.f[(y * Q + i) * nx + x])
+    }
+
+    /// Overwrites the shifted post-collision populations of node `(x, y)` (grid coupling: the
+    /// next step streams them like any other node's). Allocates nothing.
+    pub fn set_node_populations(&mut self, x: usize, y: usize, g: &[f32; Q]) {
+        let nx = self.cfg.nx;
+        for (i, v) in g.iter().enumerate() {
+            self.f[(y * Q + i) * nx + x] = *v;
+        }
+    }
+
     /// Density and (half-force-corrected) velocity of one node's shifted populations.
     #[inline(always)]
     fn density_velocity(&self, g: &[f32; Q]) -> (f32, f32, f32) {
