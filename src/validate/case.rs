@@ -69,8 +69,22 @@ pub struct Case {
     /// sides, where the weak viscosity at Re >= 30 takes hundreds of L/U to damp them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub sponge: Vec<SpongeSpec>,
+    /// Local grid refinement (`[refinement]`): a rectangle around the bodies solved on a grid
+    /// twice as fine, coupled to the grid of the level (see `hgym_solvers::lbm::Refined`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refinement: Option<RefinementSpec>,
     #[serde(default)]
     pub reference: Vec<ReferenceSpec>,
+}
+
+/// Nested refined rectangles `[x0, x1, y0, y1]` (case length units), coarsest first: inside the
+/// first the grid is twice as fine as the level's (`cells_per_length` applies outside), inside
+/// the second four times, and so on. Each lies inside the one before; the last contains every
+/// body with some room; the first stays clear of the domain's edges and absorbing layers.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RefinementSpec {
+    pub regions: Vec<[f64; 4]>,
 }
 
 /// An edge of the rectangular domain, by compass direction.
@@ -599,6 +613,41 @@ impl LoadedCase {
                         ),
                     ));
                 }
+            }
+        }
+        if let Some(rf) = &c.refinement {
+            if rf.regions.is_empty() {
+                return Err(bad(name, "refinement.regions", "list at least one region [x0, x1, y0, y1]"));
+            }
+            let mut outer = [d.x[0], d.x[1], d.y[0], d.y[1]];
+            for (k, region) in rf.regions.iter().enumerate() {
+                let [x0, x1, y0, y1] = *region;
+                if !(region.iter().all(|v| v.is_finite()) && x0 < x1 && y0 < y1) {
+                    return Err(bad(
+                        name,
+                        "refinement.regions",
+                        format!("region {} must be [x0, x1, y0, y1] with x0 < x1 and y0 < y1, got {region:?}", k + 1),
+                    ));
+                }
+                if x0 <= outer[0] || x1 >= outer[1] || y0 <= outer[2] || y1 >= outer[3] {
+                    return Err(bad(
+                        name,
+                        "refinement.regions",
+                        format!(
+                            "region {} {region:?} must lie inside {} {outer:?} with room to spare",
+                            k + 1,
+                            if k == 0 { "the domain".to_string() } else { format!("region {k}") }
+                        ),
+                    ));
+                }
+                outer = *region;
+            }
+            if c.flow.smagorinsky != 0.0 {
+                return Err(bad(
+                    name,
+                    "refinement",
+                    "the subgrid model (flow.smagorinsky) is not coupled across the refinement interface yet; drop one of them",
+                ));
             }
         }
         // Bodies inside the domain, at least two cells from every edge even at the coarse level.

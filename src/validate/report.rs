@@ -37,6 +37,18 @@ pub struct Parameters {
     pub steps_planned: u64,
     pub steps_run: u64,
     pub mlups: f64,
+    /// The nested 2:1 patches, when the case refines.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refinement: Option<RefinementParams>,
+}
+
+/// Each patch as `[x0, x1, y0, y1]` in the node indices of the grid it refines; cells per length
+/// and relaxation time of the finest grid.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct RefinementParams {
+    pub patches: Vec<[usize; 4]>,
+    pub cells_per_length: f64,
+    pub tau: f64,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -201,6 +213,11 @@ impl ValidationReport {
                 steps_planned: p.total_steps,
                 steps_run: out.steps,
                 mlups: out.mlups,
+                refinement: p.refinement.as_ref().map(|r| RefinementParams {
+                    patches: r.patches.iter().map(|p| [p.x[0], p.x[1], p.y[0], p.y[1]]).collect(),
+                    cells_per_length: r.cells_per_length,
+                    tau: r.tau,
+                }),
             },
             quantities,
             analysis: AnalysisOut {
@@ -232,6 +249,20 @@ impl ValidationReport {
                 Status::Diverged => "DIVERGED",
             }
         );
+        if let Some(r) = &self.parameters.refinement {
+            let patches: Vec<String> = r
+                .patches
+                .iter()
+                .map(|p| format!("x {}..={}, y {}..={}", p[0], p[1], p[2], p[3]))
+                .collect();
+            s += &format!(
+                "  refined 2:1 x {} around the bodies (each patch in its parent's nodes: {}): {} cells/L, tau {:.5} there\n",
+                r.patches.len(),
+                patches.join("; "),
+                r.cells_per_length,
+                r.tau
+            );
+        }
         s += &format!(
             "  {:<14} {:>10} {:>10} {:>10} {:>10}  {}\n",
             "quantity", "measured", "reference", "deviation", "tolerance", "result"

@@ -5,7 +5,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use hgym_solvers::geometry::{Circle, Naca4, OpenCavity, Rectangle, Shape, Stenosis};
-use hgym_solvers::lbm::{Collision, D2q9, D2q9Config, Grid, LbmError, Side, Sides, Units};
+use hgym_solvers::lbm::{Collision, D2q9, D2q9Config, Grid, LbmError, Patch, Refined, Side, Sides, Units};
 
 use super::case::{BoundaryKind, BoundarySpec, GeometrySpec, Level, LoadedCase, Profile, MAX_NODES};
 use super::ValidateError;
@@ -86,6 +86,18 @@ pub struct Plan {
     pub collision: Collision,
     pub spin_up_steps: u64,
     pub total_steps: u64,
+    /// The fine patch, if the case has a `[refinement]` region.
+    pub refinement: Option<RefinementPlan>,
+}
+
+/// Lattice numbers of the nested patches: each in the node indices of the grid it refines
+/// (ranges inclusive), and the finest grid's cells per length and relaxation time
+/// (`tau_l - 1/2 = 2^l (tau - 1/2)`).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct RefinementPlan {
+    pub patches: Vec<Patch>,
+    pub cells_per_length: f64,
+    pub tau: f64,
 }
 
 impl Plan {
@@ -136,6 +148,31 @@ impl Plan {
                 ),
             });
         }
+        // Cell-centred nodes: level-0 node i sits at x0 + (i + 1/2) dx; a patch takes the nodes
+        // of the grid it refines that cover its region, and its own node 0 sits on the first.
+        let refinement = case.refinement.as_ref().map(|rf| {
+            let mut origin = [d.x[0] + 0.5 * l / n, d.y[0] + 0.5 * l / n];
+            let (mut dx, mut size) = (l / n, [nx, ny]);
+            let mut patches = Vec::new();
+            for [rx0, rx1, ry0, ry1] in rf.regions.iter().copied() {
+                let lo = |v: f64, o: f64, n: usize| (((v - o) / dx).floor().max(0.0) as usize).min(n - 1);
+                let hi = |v: f64, o: f64, n: usize| (((v - o) / dx).ceil().max(0.0) as usize).min(n - 1);
+                let p = Patch {
+                    x: [lo(rx0, origin[0], size[0]), hi(rx1, origin[0], size[0])],
+                    y: [lo(ry0, origin[1], size[1]), hi(ry1, origin[1], size[1])],
+                };
+                origin = [origin[0] + p.x[0] as f64 * dx, origin[1] + p.y[0] as f64 * dx];
+                dx *= 0.5;
+                size = [2 * (p.x[1] - p.x[0]) + 1, 2 * (p.y[1] - p.y[0]) + 1];
+                patches.push(p);
+            }
+            let scale = (1u64 << patches.len()) as f64;
+            RefinementPlan {
+                patches,
+                cells_per_length: scale * n,
+                tau: 0.5 + scale * (tau - 0.5),
+            }
+        });
         // Time is in units of L/U.
         let spin_up_steps = units.steps(case.time.spin_up);
         let total_steps = spin_up_steps + units.steps(case.time.average);
@@ -149,6 +186,7 @@ impl Plan {
             collision: case.flow.collision,
             spin_up_steps,
             total_steps,
+            refinement,
         })
     }
 }
@@ -232,7 +270,11 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     cfg.sponges = case.sponge.iter().map(|sp| sp.lattice(n, u)).collect();
     let bodies: Vec<_> = std::iter::once(&case.geometry).chain(&case.more_bodies).map(build_shape).collect();
     let n_bodies = bodies.len();
-    let mut solver = D2q9::new(cfg, bodies).map_err(|e| match e {
+    let built = match &plan.refinement {
+        None => D2q9::new(cfg, bodies).map(|s| Grids::Uniform(Box::new(s))),
+        Some(r) => Refined::new(cfg, &r.patches, bodies).map(Grids::Refined),
+    };
+    let mut solver = built.map_err(|e| match e {
         LbmError::Config { field, message } => ValidateError::Unrunnable {
             case: case.case.name.clone(),
             field: field.to_string(),
@@ -302,8 +344,8 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     progress(solver.time(), total);
     let wall = started.elapsed().as_secs_f64();
     let steps = solver.time();
-    let mlups = (solver.fluid_nodes() as f64 * steps as f64) / wall.max(1e-9) / 1e6;
-    let vorticity = vorticity_field(&solver, &plan.units, [d.x[0], d.x[1], d.y[0], d.y[1]]);
+    let mlups = (solver.node_updates_per_step() as f64 * steps as f64) / wall.max(1e-9) / 1e6;
+    let vorticity = vorticity_field(solver.coarse(), &plan.units, [d.x[0], d.x[1], d.y[0], d.y[1]]);
     Ok(RunOutput {
         plan: plan.clone(),
         t,
@@ -317,6 +359,62 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
         steps,
         mlups,
     })
+}
+
+/// The grid(s) a case runs on: one uniform grid, or a coarse grid with a fine patch.
+enum Grids {
+    Uniform(Box<D2q9>),
+    Refined(Refined),
+}
+
+impl Grids {
+    fn step(&mut self) -> Result<(), LbmError> {
+        match self {
+            Grids::Uniform(s) => s.step(),
+            Grids::Refined(r) => r.step(),
+        }
+    }
+
+    /// Forces on the bodies in the level's lattice units (from the patch when refined).
+    fn body_forces(&self) -> &[[f64; 2]] {
+        match self {
+            Grids::Uniform(s) => s.body_forces(),
+            Grids::Refined(r) => r.body_forces(),
+        }
+    }
+
+    fn set_boundary_velocity_scale(&mut self, scale: f64) {
+        match self {
+            Grids::Uniform(s) => s.set_boundary_velocity_scale(scale),
+            Grids::Refined(r) => r.set_boundary_velocity_scale(scale),
+        }
+    }
+
+    fn init_with(&mut self, field: impl FnMut(f64, f64) -> (f64, f64, f64)) {
+        match self {
+            Grids::Uniform(s) => s.init_with(field),
+            Grids::Refined(r) => r.init_with(field),
+        }
+    }
+
+    /// The grid over the whole domain.
+    fn coarse(&self) -> &D2q9 {
+        match self {
+            Grids::Uniform(s) => s,
+            Grids::Refined(r) => r.coarse(),
+        }
+    }
+
+    fn time(&self) -> u64 {
+        self.coarse().time()
+    }
+
+    fn node_updates_per_step(&self) -> usize {
+        match self {
+            Grids::Uniform(s) => s.fluid_nodes(),
+            Grids::Refined(r) => r.node_updates_per_step(),
+        }
+    }
 }
 
 /// Vorticity `w = dv/dx - du/dy` by central differences, in units of U/L; NaN in bodies and

@@ -1,5 +1,5 @@
-//! Two-level local grid refinement (2:1) of the D2Q9 solver: a fine patch around the bodies,
-//! embedded in the coarse grid that covers the whole domain.
+//! Local grid refinement (2:1 per level) of the D2Q9 solver: nested fine patches around the
+//! bodies, embedded in the coarse grid that covers the whole domain.
 //!
 //! The scheme is the vertex-centred coupling of Lagrava, Malaspinas, Latt & Chopard (J. Comput.
 //! Phys. 231, 4808, 2012) with the regularised populations of Latt & Chopard (2006) at the
@@ -8,7 +8,7 @@
 //! `tau_f - 1/2 = 2 (tau_c - 1/2)`, and the non-equilibrium stress, `Pi^neq = -2 rho c_s^2 tau S dt`,
 //! scales between the grids as `Pi_f = Pi_c tau_f / (2 tau_c)`.
 //!
-//! One coarse step `t -> t + 1`:
+//! One step `t -> t + 1` of a grid with a patch (applied recursively through the levels):
 //! 1. the coarse grid steps everywhere (its nodes under the patch hold the fine solution, see 4);
 //! 2. on the patch's four edge lines (coarse nodes) the density, velocity and post-collision
 //!    stress are read before and after the step;
@@ -40,8 +40,8 @@ use super::error::LbmError;
 use super::solver::{D2q9, D2q9Config};
 use crate::geometry::Shape;
 
-/// The refined rectangle in coarse node indices, both ends included.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// A refined rectangle in the node indices of the grid it refines, both ends included.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Patch {
     pub x: [usize; 2],
     pub y: [usize; 2],
@@ -50,32 +50,38 @@ pub struct Patch {
 /// Density deviation, velocity and post-collision Hermite stress `[xx, yy, xy]` of one node.
 type Moments = [f32; 6];
 
-/// Nodes the patch keeps between a body and its edge, and between its edge and the domain's.
+/// Nodes a patch keeps between a body and its edge, and between its edge and the edge of the
+/// grid it refines.
 const BODY_MARGIN_FINE: usize = 4;
 const EDGE_MARGIN_COARSE: usize = 2;
 
-/// A coarse D2Q9 grid with one fine patch (see the module docs).
-pub struct Refined {
-    coarse: D2q9,
-    fine: D2q9,
+/// The coupling between grid `l` and the patch `l + 1` inside it.
+struct Coupling {
+    /// The patch in grid `l`'s node indices.
     patch: Patch,
     /// Post-collision stress factors coarse -> fine and fine -> coarse.
     c2f: f32,
     f2c: f32,
-    /// Coarse moments on the patch's edge lines (south, north: along x; west, east: along y) at
-    /// the start (`old`) and the end (`new`) of the current coarse step.
+    /// Grid `l`'s moments on the patch's edge lines (south, north: along x; west, east: along
+    /// y) at the start (`old`) and the end (`new`) of grid `l`'s current step.
     old: [Vec<Moments>; 4],
     new: [Vec<Moments>; 4],
-    /// Mean force of the two fine sub-steps, in coarse lattice units.
+}
+
+/// A D2Q9 grid over the whole domain with nested 2:1 patches around the bodies (see the module
+/// docs): level 0 is the coarse grid, each further level refines a rectangle of the one before.
+pub struct Refined {
+    levels: Vec<D2q9>,
+    couplings: Vec<Coupling>,
+    /// Mean force over the last coarse step, from the finest level, in coarse lattice units.
     forces: Vec<[f64; 2]>,
 }
 
 impl std::fmt::Debug for Refined {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Refined")
-            .field("coarse", &self.coarse)
-            .field("fine", &self.fine)
-            .field("patch", &self.patch)
+            .field("levels", &self.levels)
+            .field("patches", &self.couplings.iter().map(|c| c.patch).collect::<Vec<_>>())
             .finish()
     }
 }
@@ -88,38 +94,13 @@ fn config_error(message: impl Into<String>) -> LbmError {
 }
 
 impl Refined {
-    /// Plans both grids: `cfg` is the coarse grid over the whole domain, `patch` the refined
-    /// rectangle (which must contain every body with a margin and stay clear of the domain's
-    /// edges and absorbing layers).
-    pub fn new(cfg: D2q9Config, patch: Patch, bodies: Vec<Arc<dyn Shape>>) -> Result<Self, LbmError> {
-        let (nx, ny) = (cfg.nx, cfg.ny);
-        let [x0, x1] = patch.x;
-        let [y0, y1] = patch.y;
-        if x1 < x0 + 4 || y1 < y0 + 4 {
-            return Err(config_error(format!(
-                "the patch x {x0}..={x1}, y {y0}..={y1} (coarse nodes) must span at least 4 coarse cells each way"
-            )));
-        }
-        let m = EDGE_MARGIN_COARSE;
-        if x0 < m || y0 < m || x1 + m >= nx || y1 + m >= ny {
-            return Err(config_error(format!(
-                "the patch x {x0}..={x1}, y {y0}..={y1} must keep {m} coarse nodes from the domain's edges (0..{nx} x 0..{ny})"
-            )));
-        }
-        for sp in &cfg.sponges {
-            let clear = match sp.edge {
-                Edge::West => x0 > sp.width + m,
-                Edge::East => x1 + sp.width + m < nx,
-                Edge::South => y0 > sp.width + m,
-                Edge::North => y1 + sp.width + m < ny,
-            };
-            if !clear {
-                return Err(config_error(format!(
-                    "the patch overlaps the {} absorbing layer ({} nodes); move it or thin the layer",
-                    sp.edge.name(),
-                    sp.width
-                )));
-            }
+    /// Plans every grid: `cfg` is the coarse grid over the whole domain; `patches[0]` refines a
+    /// rectangle of it (coarse node indices), `patches[1]` a rectangle of that patch (its node
+    /// indices), and so on. The finest patch must contain every body with a margin; each patch
+    /// stays clear of the edges of the grid it refines and of the absorbing layers.
+    pub fn new(cfg: D2q9Config, patches: &[Patch], bodies: Vec<Arc<dyn Shape>>) -> Result<Self, LbmError> {
+        if patches.is_empty() {
+            return Err(config_error("at least one patch is needed (use D2q9 for a uniform grid)"));
         }
         if cfg.smagorinsky != 0.0 {
             return Err(config_error(
@@ -129,96 +110,169 @@ impl Refined {
         if cfg.body_force != [0.0, 0.0] {
             return Err(config_error("a body force is not coupled across the interface yet"));
         }
-        let tau_c = cfg.tau;
-        let tau_f = 0.5 + 2.0 * (tau_c - 0.5);
-        if (tau_c - 1.0).abs() < 0.05 || (tau_f - 1.0).abs() < 0.05 {
-            return Err(config_error(format!(
-                "tau = {tau_c:.4} (fine grid {tau_f:.4}): the coupling rebuilds the stress from post-collision \
-                 populations, which carry none at tau = 1; keep both relaxation times 0.05 away from 1 \
-                 (change the lattice velocity)"
-            )));
+        for sp in &cfg.sponges {
+            let p = patches[0];
+            let (nx, ny, m) = (cfg.nx, cfg.ny, EDGE_MARGIN_COARSE);
+            let clear = match sp.edge {
+                Edge::West => p.x[0] > sp.width + m,
+                Edge::East => p.x[1] + sp.width + m < nx,
+                Edge::South => p.y[0] > sp.width + m,
+                Edge::North => p.y[1] + sp.width + m < ny,
+            };
+            if !clear {
+                return Err(config_error(format!(
+                    "the patch overlaps the {} absorbing layer ({} nodes); move it or thin the layer",
+                    sp.edge.name(),
+                    sp.width
+                )));
+            }
         }
-        let mut fine_cfg = D2q9Config::new(2 * (x1 - x0) + 1, 2 * (y1 - y0) + 1, tau_f, Sides::periodic());
-        fine_cfg.collision = cfg.collision;
-        fine_cfg.grid = Grid {
-            origin: cfg.grid.position(x0 as f64, y0 as f64),
-            dx: 0.5 * cfg.grid.dx,
-        };
-        fine_cfg.check_interval = 2 * cfg.check_interval;
-        fine_cfg.rho_bounds = cfg.rho_bounds;
-        fine_cfg.u_max = cfg.u_max;
-        fine_cfg.stream_stores = cfg.stream_stores;
-        let fine = D2q9::new(fine_cfg, bodies.clone())?;
-        let coarse = D2q9::new(cfg, bodies)?;
+        let mut cfgs = vec![cfg];
+        for (l, p) in patches.iter().enumerate() {
+            let parent = &cfgs[l];
+            let (nx, ny) = (parent.nx, parent.ny);
+            let ([x0, x1], [y0, y1]) = (p.x, p.y);
+            if x1 < x0 + 4 || y1 < y0 + 4 {
+                return Err(config_error(format!(
+                    "patch {} (x {x0}..={x1}, y {y0}..={y1} in level {l}'s nodes) must span at least 4 cells each way",
+                    l + 1
+                )));
+            }
+            let m = EDGE_MARGIN_COARSE;
+            if x0 < m || y0 < m || x1 + m >= nx || y1 + m >= ny {
+                return Err(config_error(format!(
+                    "patch {} (x {x0}..={x1}, y {y0}..={y1}) must keep {m} nodes from the edges of level {l} (0..{nx} x 0..{ny})",
+                    l + 1
+                )));
+            }
+            let tau_c = parent.tau;
+            let tau_f = 0.5 + 2.0 * (tau_c - 0.5);
+            if (tau_c - 1.0).abs() < 0.05 || (tau_f - 1.0).abs() < 0.05 {
+                return Err(config_error(format!(
+                    "tau = {tau_c:.4} on level {l}, {tau_f:.4} on level {}: the coupling rebuilds the stress from \
+                     post-collision populations, which carry none at tau = 1; keep every level's relaxation time 0.05 \
+                     away from 1 (change the lattice velocity or the number of levels)",
+                    l + 1
+                )));
+            }
+            let mut fine = D2q9Config::new(2 * (x1 - x0) + 1, 2 * (y1 - y0) + 1, tau_f, Sides::periodic());
+            fine.collision = parent.collision;
+            fine.grid = Grid {
+                origin: parent.grid.position(x0 as f64, y0 as f64),
+                dx: 0.5 * parent.grid.dx,
+            };
+            fine.check_interval = 2 * parent.check_interval;
+            fine.rho_bounds = parent.rho_bounds;
+            fine.u_max = parent.u_max;
+            fine.stream_stores = parent.stream_stores;
+            cfgs.push(fine);
+        }
+        let levels = cfgs
+            .into_iter()
+            .map(|c| D2q9::new(c, bodies.clone()))
+            .collect::<Result<Vec<_>, _>>()?;
 
-        let (fx, fy) = (fine.nx(), fine.ny());
+        let finest = &levels[levels.len() - 1];
+        let (fx, fy) = (finest.nx(), finest.ny());
+        let k = BODY_MARGIN_FINE;
         for y in 0..fy {
             for x in 0..fx {
-                let near_edge = x < BODY_MARGIN_FINE || y < BODY_MARGIN_FINE || x + BODY_MARGIN_FINE >= fx || y + BODY_MARGIN_FINE >= fy;
-                if near_edge && fine.is_solid(x, y) {
+                if (x < k || y < k || x + k >= fx || y + k >= fy) && finest.is_solid(x, y) {
                     return Err(config_error(format!(
-                        "a body reaches within {BODY_MARGIN_FINE} fine nodes of the patch's edge; enlarge the patch"
+                        "a body reaches within {k} nodes of the finest patch's edge; enlarge the patch"
                     )));
                 }
             }
         }
-        for y in 0..ny {
-            for x in 0..nx {
-                let inside = x > x0 + 1 && x + 1 < x1 && y > y0 + 1 && y + 1 < y1;
-                if coarse.is_solid(x, y) && !inside {
-                    return Err(config_error(format!(
-                        "coarse node ({x}, {y}) is inside a body but outside the patch; every body must lie in the patch"
-                    )));
+        for (l, p) in patches.iter().enumerate() {
+            let grid = &levels[l];
+            for y in 0..grid.ny() {
+                for x in 0..grid.nx() {
+                    let inside = x > p.x[0] + 1 && x + 1 < p.x[1] && y > p.y[0] + 1 && y + 1 < p.y[1];
+                    if grid.is_solid(x, y) && !inside {
+                        return Err(config_error(format!(
+                            "node ({x}, {y}) of level {l} is inside a body but outside patch {}; every body must lie in \
+                             every patch",
+                            l + 1
+                        )));
+                    }
                 }
             }
         }
 
-        let n_bodies = coarse.bodies().len();
-        let lines = [x1 - x0 + 1, x1 - x0 + 1, y1 - y0 + 1, y1 - y0 + 1];
+        let couplings = patches
+            .iter()
+            .zip(&levels)
+            .map(|(p, coarse)| {
+                let tau_c = coarse.config().tau;
+                let tau_f = 0.5 + 2.0 * (tau_c - 0.5);
+                let lines = [p.x[1] - p.x[0] + 1, p.x[1] - p.x[0] + 1, p.y[1] - p.y[0] + 1, p.y[1] - p.y[0] + 1];
+                Coupling {
+                    patch: *p,
+                    c2f: ((tau_f - 1.0) / (2.0 * (tau_c - 1.0))) as f32,
+                    f2c: ((2.0 * (tau_c - 1.0)) / (tau_f - 1.0)) as f32,
+                    old: lines.map(|n| vec![[0.0; 6]; n]),
+                    new: lines.map(|n| vec![[0.0; 6]; n]),
+                }
+            })
+            .collect();
+        let n_bodies = levels[0].bodies().len();
         let mut r = Refined {
-            coarse,
-            fine,
-            patch,
-            c2f: ((tau_f - 1.0) / (2.0 * (tau_c - 1.0))) as f32,
-            f2c: ((2.0 * (tau_c - 1.0)) / (tau_f - 1.0)) as f32,
-            old: lines.map(|n| vec![[0.0; 6]; n]),
-            new: lines.map(|n| vec![[0.0; 6]; n]),
+            levels,
+            couplings,
             forces: vec![[0.0; 2]; n_bodies],
         };
         r.init_with(|_, _| (1.0, 0.0, 0.0));
         Ok(r)
     }
 
-    /// Sets both grids to the equilibrium of `(rho, ux, uy) = field(x, y)` (physical position,
-    /// lattice density and velocity, the same on both grids); resets the time.
+    /// Sets every grid to the equilibrium of `(rho, ux, uy) = field(x, y)` (physical position,
+    /// lattice density and velocity, the same on all grids); resets the time.
     pub fn init_with(&mut self, mut field: impl FnMut(f64, f64) -> (f64, f64, f64)) {
-        self.coarse.init_with(&mut field);
-        self.fine.init_with(&mut field);
-        self.read_edges();
-        self.old.clone_from(&self.new);
+        for grid in &mut self.levels {
+            grid.init_with(&mut field);
+        }
+        for l in 0..self.couplings.len() {
+            read_edges(&self.levels[l], &mut self.couplings[l]);
+            let c = &mut self.couplings[l];
+            c.old.clone_from(&c.new);
+        }
     }
 
-    /// One coarse step (two fine sub-steps). Allocates nothing.
+    /// One coarse step (`2^l` steps of level `l`). Allocates nothing.
     pub fn step(&mut self) -> Result<(), LbmError> {
-        std::mem::swap(&mut self.old, &mut self.new);
-        self.coarse.step()?;
-        self.read_edges();
         for f in self.forces.iter_mut() {
             *f = [0.0; 2];
         }
-        for theta in [0.5f32, 1.0] {
-            if let Err(e) = self.fine.step() {
-                return Err(self.on_fine(e));
-            }
-            for (acc, f) in self.forces.iter_mut().zip(self.fine.body_forces()) {
-                // Mean of the two sub-steps, and a fine-lattice force is half the coarse-lattice
-                // force with the same coefficient (the reference length doubles).
-                acc[0] += 0.25 * f[0];
-                acc[1] += 0.25 * f[1];
-            }
-            self.write_ring(theta);
+        self.step_level(0)
+    }
+
+    /// One step of level `l` and, recursively, two of every finer level.
+    fn step_level(&mut self, l: usize) -> Result<(), LbmError> {
+        if let Err(e) = self.levels[l].step() {
+            return Err(self.located(l, e));
         }
-        self.restrict();
+        if l + 1 == self.levels.len() {
+            // Mean over the 2^l sub-steps, and a force on level l is 2^-l times the coarse-lattice
+            // force with the same coefficient (the reference length doubles per level).
+            let w = 0.25f64.powi(l as i32);
+            for (acc, f) in self.forces.iter_mut().zip(self.levels[l].body_forces()) {
+                acc[0] += w * f[0];
+                acc[1] += w * f[1];
+            }
+            return Ok(());
+        }
+        {
+            let c = &mut self.couplings[l];
+            std::mem::swap(&mut c.old, &mut c.new);
+            read_edges(&self.levels[l], c);
+        }
+        for theta in [0.5f32, 1.0] {
+            self.step_level(l + 1)?;
+            write_ring(&mut self.levels[l + 1], &self.couplings[l], theta);
+        }
+        let (coarse, fine) = self.levels.split_at_mut(l + 1);
+        restrict(&mut coarse[l], &fine[0], &self.couplings[l]);
         Ok(())
     }
 
@@ -230,114 +284,116 @@ impl Refined {
         Ok(())
     }
 
-    /// A fine-grid divergence, located on the coarse grid.
-    fn on_fine(&self, e: LbmError) -> LbmError {
+    /// A divergence on level `l`, located on the coarse grid.
+    fn located(&self, l: usize, e: LbmError) -> LbmError {
         match e {
-            LbmError::Diverged { reason, x, y, .. } => LbmError::Diverged {
-                step: self.coarse.time(),
-                reason: format!("{reason} (fine patch)"),
-                x: self.patch.x[0] + x / 2,
-                y: self.patch.y[0] + y / 2,
-            },
+            LbmError::Diverged { reason, mut x, mut y, .. } if l > 0 => {
+                for c in self.couplings[..l].iter().rev() {
+                    x = c.patch.x[0] + x / 2;
+                    y = c.patch.y[0] + y / 2;
+                }
+                LbmError::Diverged {
+                    step: self.levels[0].time(),
+                    reason: format!("{reason} (refinement level {l})"),
+                    x,
+                    y,
+                }
+            }
             other => other,
         }
     }
 
-    /// Reads the coarse moments on the four edge lines into `new`.
-    fn read_edges(&mut self) {
-        let [x0, x1] = self.patch.x;
-        let [y0, y1] = self.patch.y;
-        let c = &self.coarse;
-        let read = |x: usize, y: usize| -> Moments {
-            let (d, ux, uy, q) = hermite_stress(&c.node_populations(x, y));
-            [d, ux, uy, q[0], q[1], q[2]]
-        };
-        let [south, north, west, east] = &mut self.new;
-        for (k, x) in (x0..=x1).enumerate() {
-            south[k] = read(x, y0);
-            north[k] = read(x, y1);
-        }
-        for (k, y) in (y0..=y1).enumerate() {
-            west[k] = read(x0, y);
-            east[k] = read(x1, y);
-        }
-    }
-
-    /// Overwrites the fine grid's outer ring with populations rebuilt from the coarse edge
-    /// moments at time `t + theta` (coarse steps).
-    fn write_ring(&mut self, theta: f32) {
-        let (fx, fy) = (self.fine.nx(), self.fine.ny());
-        let c2f = self.c2f;
-        let (old, new) = (&self.old, &self.new);
-        let at = |line: usize, i: usize| -> [f32; super::lattice::Q] {
-            let a = interp(&old[line], i);
-            let b = interp(&new[line], i);
-            let m: Moments = std::array::from_fn(|k| (1.0 - theta) * a[k] + theta * b[k]);
-            hermite_populations(m[0], m[1], m[2], [c2f * m[3], c2f * m[4], c2f * m[5]])
-        };
-        for i in 0..fx {
-            let s = at(0, i);
-            let n = at(1, i);
-            self.fine.set_node_populations(i, 0, &s);
-            self.fine.set_node_populations(i, fy - 1, &n);
-        }
-        for j in 1..fy - 1 {
-            let w = at(2, j);
-            let e = at(3, j);
-            self.fine.set_node_populations(0, j, &w);
-            self.fine.set_node_populations(fx - 1, j, &e);
-        }
-    }
-
-    /// Gives every coarse node strictly inside the patch the moments of the fine node on it.
-    fn restrict(&mut self) {
-        let [x0, x1] = self.patch.x;
-        let [y0, y1] = self.patch.y;
-        let f2c = self.f2c;
-        for y in y0 + 1..y1 {
-            for x in x0 + 1..x1 {
-                let (xf, yf) = (2 * (x - x0), 2 * (y - y0));
-                if self.fine.is_solid(xf, yf) || self.coarse.is_solid(x, y) {
-                    continue;
-                }
-                let (d, ux, uy, q) = hermite_stress(&self.fine.node_populations(xf, yf));
-                let g = hermite_populations(d, ux, uy, [f2c * q[0], f2c * q[1], f2c * q[2]]);
-                self.coarse.set_node_populations(x, y, &g);
-            }
-        }
-    }
-
-    /// Hydrodynamic force on each body (from the fine grid), averaged over the last coarse step
-    /// and expressed in coarse lattice units, so coefficients use the coarse reference length.
+    /// Hydrodynamic force on each body (from the finest level), averaged over the last coarse
+    /// step and expressed in coarse lattice units, so coefficients use the coarse reference
+    /// length.
     pub fn body_forces(&self) -> &[[f64; 2]] {
         &self.forces
     }
 
     /// Multiplies the coarse grid's velocity sides by `scale` (inlet ramps).
     pub fn set_boundary_velocity_scale(&mut self, scale: f64) {
-        self.coarse.set_boundary_velocity_scale(scale);
+        self.levels[0].set_boundary_velocity_scale(scale);
     }
 
+    /// The grid over the whole domain.
     pub fn coarse(&self) -> &D2q9 {
-        &self.coarse
+        &self.levels[0]
     }
 
+    /// The finest patch.
     pub fn fine(&self) -> &D2q9 {
-        &self.fine
+        &self.levels[self.levels.len() - 1]
     }
 
-    pub fn patch(&self) -> Patch {
-        self.patch
+    /// Every grid, coarse first.
+    pub fn levels(&self) -> &[D2q9] {
+        &self.levels
     }
 
     /// Coarse steps since the last initialisation.
     pub fn time(&self) -> u64 {
-        self.coarse.time()
+        self.levels[0].time()
     }
 
-    /// Node updates per coarse step (coarse fluid nodes plus twice the fine ones), for MLUPS.
+    /// Node updates per coarse step (level `l`'s fluid nodes count `2^l` times), for MLUPS.
     pub fn node_updates_per_step(&self) -> usize {
-        self.coarse.fluid_nodes() + 2 * self.fine.fluid_nodes()
+        self.levels.iter().enumerate().map(|(l, g)| g.fluid_nodes() << l).sum()
+    }
+}
+
+/// Reads grid `coarse`'s moments on the patch's four edge lines into `c.new`.
+fn read_edges(coarse: &D2q9, c: &mut Coupling) {
+    let [x0, x1] = c.patch.x;
+    let [y0, y1] = c.patch.y;
+    let read = |x: usize, y: usize| -> Moments {
+        let (d, ux, uy, q) = hermite_stress(&coarse.node_populations(x, y));
+        [d, ux, uy, q[0], q[1], q[2]]
+    };
+    let [south, north, west, east] = &mut c.new;
+    for (k, x) in (x0..=x1).enumerate() {
+        south[k] = read(x, y0);
+        north[k] = read(x, y1);
+    }
+    for (k, y) in (y0..=y1).enumerate() {
+        west[k] = read(x0, y);
+        east[k] = read(x1, y);
+    }
+}
+
+/// Overwrites the patch's outer ring with populations rebuilt from the coarse edge moments at
+/// time `t + theta` (coarse steps).
+fn write_ring(fine: &mut D2q9, c: &Coupling, theta: f32) {
+    let (fx, fy) = (fine.nx(), fine.ny());
+    let at = |line: usize, i: usize| -> [f32; super::lattice::Q] {
+        let a = interp(&c.old[line], i);
+        let b = interp(&c.new[line], i);
+        let m: Moments = std::array::from_fn(|k| (1.0 - theta) * a[k] + theta * b[k]);
+        hermite_populations(m[0], m[1], m[2], [c.c2f * m[3], c.c2f * m[4], c.c2f * m[5]])
+    };
+    for i in 0..fx {
+        fine.set_node_populations(i, 0, &at(0, i));
+        fine.set_node_populations(i, fy - 1, &at(1, i));
+    }
+    for j in 1..fy - 1 {
+        fine.set_node_populations(0, j, &at(2, j));
+        fine.set_node_populations(fx - 1, j, &at(3, j));
+    }
+}
+
+/// Gives every coarse node strictly inside the patch the moments of the fine node on it.
+fn restrict(coarse: &mut D2q9, fine: &D2q9, c: &Coupling) {
+    let [x0, x1] = c.patch.x;
+    let [y0, y1] = c.patch.y;
+    for y in y0 + 1..y1 {
+        for x in x0 + 1..x1 {
+            let (xf, yf) = (2 * (x - x0), 2 * (y - y0));
+            if fine.is_solid(xf, yf) || coarse.is_solid(x, y) {
+                continue;
+            }
+            let (d, ux, uy, q) = hermite_stress(&fine.node_populations(xf, yf));
+            let g = hermite_populations(d, ux, uy, [c.f2c * q[0], c.f2c * q[1], c.f2c * q[2]]);
+            coarse.set_node_populations(x, y, &g);
+        }
     }
 }
 
