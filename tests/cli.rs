@@ -491,8 +491,8 @@ fn run_writes_metrics_plots_and_manifest() {
 fn a_refined_case_runs_records_its_patch_and_improves_the_drag() {
     let dir = tempfile::tempdir().unwrap();
     let plain = std::fs::read_to_string(repo().join("tests/cases/schaefer_turek_2d1.toml")).unwrap();
-    let refined = plain.replace("name = \"schaefer_turek_2d1\"", "name = \"st_refined\"")
-        + "\n[refinement]\nregions = [[0.8, 6.0, 0.3, 3.8]]\n";
+    let refined =
+        plain.replace("name = \"schaefer_turek_2d1\"", "name = \"st_refined\"") + "\n[refinement]\nregions = [[0.8, 6.0, 0.3, 3.8]]\n";
     let case = write_case(dir.path(), "st_refined", &refined);
     let out = dir.path().join("out");
     let o = run_coarse(&case, &out, false);

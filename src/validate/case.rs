@@ -642,13 +642,6 @@ impl LoadedCase {
                 }
                 outer = *region;
             }
-            if c.flow.smagorinsky != 0.0 {
-                return Err(bad(
-                    name,
-                    "refinement",
-                    "the subgrid model (flow.smagorinsky) is not coupled across the refinement interface yet; drop one of them",
-                ));
-            }
         }
         // Bodies inside the domain, at least two cells from every edge even at the coarse level.
         let dx = l / r.coarse.min(r.default).min(r.fine) as f64;

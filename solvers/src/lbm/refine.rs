@@ -22,10 +22,11 @@
 //! Both grids store post-collision populations. After a regularised collision these are
 //! `g^eq + (1 - omega) Pi^neq` projected on the Hermite polynomials ([`hermite_stress`] reads the
 //! stress back, [`hermite_populations`] rebuilds them), so a post-collision stress converts as
-//! `Pi*_f = Pi*_c (tau_f - 1) / (2 (tau_c - 1))`. That is singular where either relaxation time
-//! is 1 (the post-collision stress vanishes there), so such set-ups are refused; the flows that
-//! need refinement run at `tau` close to 1/2. BGK runs too: the interface keeps only the Hermite
-//! part of its non-equilibrium populations.
+//! `Pi*_f = Pi*_c (tau_f - 1) / (2 (tau_c - 1))`, with the local relaxation times of the
+//! Smagorinsky model when it is on ([`StressMap`]). That is singular where a relaxation time is 1
+//! (the post-collision stress vanishes there), so such set-ups are refused; the flows that need
+//! refinement run at `tau` close to 1/2. BGK runs too: the interface keeps only the Hermite part
+//! of its non-equilibrium populations.
 //!
 //! Bodies live on the fine grid (forces come from there); the coarse grid marks them solid too,
 //! but its nodes near them are overwritten each step. Sponges and domain edges stay on the coarse
@@ -59,9 +60,8 @@ const EDGE_MARGIN_COARSE: usize = 2;
 struct Coupling {
     /// The patch in grid `l`'s node indices.
     patch: Patch,
-    /// Post-collision stress factors coarse -> fine and fine -> coarse.
-    c2f: f32,
-    f2c: f32,
+    /// Stress conversion between the two grids' post-collision states.
+    convert: StressMap,
     /// Grid `l`'s moments on the patch's edge lines (south, north: along x; west, east: along
     /// y) at the start (`old`) and the end (`new`) of grid `l`'s current step.
     old: [Vec<Moments>; 4],
@@ -101,11 +101,6 @@ impl Refined {
     pub fn new(cfg: D2q9Config, patches: &[Patch], bodies: Vec<Arc<dyn Shape>>) -> Result<Self, LbmError> {
         if patches.is_empty() {
             return Err(config_error("at least one patch is needed (use D2q9 for a uniform grid)"));
-        }
-        if cfg.smagorinsky != 0.0 {
-            return Err(config_error(
-                "the subgrid model is not coupled across the interface yet; refine without smagorinsky",
-            ));
         }
         if cfg.body_force != [0.0, 0.0] {
             return Err(config_error("a body force is not coupled across the interface yet"));
@@ -157,6 +152,7 @@ impl Refined {
             }
             let mut fine = D2q9Config::new(2 * (x1 - x0) + 1, 2 * (y1 - y0) + 1, tau_f, Sides::periodic());
             fine.collision = parent.collision;
+            fine.smagorinsky = parent.smagorinsky;
             fine.grid = Grid {
                 origin: parent.grid.position(x0 as f64, y0 as f64),
                 dx: 0.5 * parent.grid.dx,
@@ -209,8 +205,7 @@ impl Refined {
                 let lines = [p.x[1] - p.x[0] + 1, p.x[1] - p.x[0] + 1, p.y[1] - p.y[0] + 1, p.y[1] - p.y[0] + 1];
                 Coupling {
                     patch: *p,
-                    c2f: ((tau_f - 1.0) / (2.0 * (tau_c - 1.0))) as f32,
-                    f2c: ((2.0 * (tau_c - 1.0)) / (tau_f - 1.0)) as f32,
+                    convert: StressMap::new(tau_c, tau_f, coarse.config().smagorinsky),
                     old: lines.map(|n| vec![[0.0; 6]; n]),
                     new: lines.map(|n| vec![[0.0; 6]; n]),
                 }
@@ -368,7 +363,8 @@ fn write_ring(fine: &mut D2q9, c: &Coupling, theta: f32) {
         let a = interp(&c.old[line], i);
         let b = interp(&c.new[line], i);
         let m: Moments = std::array::from_fn(|k| (1.0 - theta) * a[k] + theta * b[k]);
-        hermite_populations(m[0], m[1], m[2], [c.c2f * m[3], c.c2f * m[4], c.c2f * m[5]])
+        let q = c.convert.to_fine(1.0 + m[0], [m[3], m[4], m[5]]);
+        hermite_populations(m[0], m[1], m[2], q)
     };
     for i in 0..fx {
         fine.set_node_populations(i, 0, &at(0, i));
@@ -391,9 +387,67 @@ fn restrict(coarse: &mut D2q9, fine: &D2q9, c: &Coupling) {
                 continue;
             }
             let (d, ux, uy, q) = hermite_stress(&fine.node_populations(xf, yf));
-            let g = hermite_populations(d, ux, uy, [c.f2c * q[0], c.f2c * q[1], c.f2c * q[2]]);
+            let g = hermite_populations(d, ux, uy, c.convert.to_coarse(1.0 + d, q));
             coarse.set_node_populations(x, y, &g);
         }
+    }
+}
+
+/// Converts a post-collision non-equilibrium stress between a grid and its 2:1 patch.
+///
+/// Chapman-Enskog gives `Pi^neq = -2 rho c_s^2 tau S` (lattice units), so after a collision
+/// `Pi* = (1 - 1/tau) Pi^neq = -2 rho c_s^2 (tau - 1) S`; the strain rate in lattice units halves
+/// from the coarse grid to the fine one. With the Smagorinsky model the relaxation time is local,
+/// `tau = tau0 + a |S|` with `a = les / 6` (the closed form of [`super::collision::collide_les`]'s
+/// quadratic, `|S|` the Frobenius norm), so `|Pi*| = 2 rho c_s^2 (1 - tau0 - a |S|) |S|` is solved
+/// for `|S|` (the smaller root, where `tau < 1`); without it `a = 0` and the map is the constant
+/// factor `(tau_f - 1) / (2 (tau_c - 1))`. The trace of the stress (relaxed with its own rate) is
+/// carried along with the same factor, as its post-collision value is zero for the regularised
+/// operator anyway.
+#[derive(Clone, Copy, Debug)]
+struct StressMap {
+    tau_c: f32,
+    tau_f: f32,
+    a: f32,
+}
+
+impl StressMap {
+    fn new(tau_c: f64, tau_f: f64, smagorinsky: f64) -> Self {
+        StressMap {
+            tau_c: tau_c as f32,
+            tau_f: tau_f as f32,
+            a: (18.0 * 2f64.sqrt() * smagorinsky * smagorinsky / 6.0) as f32,
+        }
+    }
+
+    /// `|S|` and the local `tau` of a post-collision stress `q` on a grid with `tau0`.
+    #[inline]
+    fn strain(&self, rho: f32, q: [f32; 3], tau0: f32) -> (f32, f32) {
+        let norm = (q[0] * q[0] + q[1] * q[1] + 2.0 * q[2] * q[2]).sqrt();
+        let b = 1.0 - tau0;
+        let c = 1.5 * norm / rho;
+        // a s^2 - b s + c = 0, smaller root written without cancellation (a = 0 gives s = c / b).
+        let disc = (b * b - 4.0 * self.a * c).max(0.0);
+        let s = 2.0 * c / (b + disc.sqrt());
+        (s, tau0 + self.a * s)
+    }
+
+    /// Coarse post-collision stress to the fine grid's.
+    #[inline]
+    fn to_fine(self, rho: f32, q: [f32; 3]) -> [f32; 3] {
+        let (s, tau_c) = self.strain(rho, q, self.tau_c);
+        let tau_f = self.tau_f + self.a * 0.5 * s;
+        let k = (tau_f - 1.0) / (2.0 * (tau_c - 1.0));
+        q.map(|v| k * v)
+    }
+
+    /// Fine post-collision stress to the coarse grid's.
+    #[inline]
+    fn to_coarse(self, rho: f32, q: [f32; 3]) -> [f32; 3] {
+        let (s, tau_f) = self.strain(rho, q, self.tau_f);
+        let tau_c = self.tau_c + self.a * 2.0 * s;
+        let k = 2.0 * (tau_c - 1.0) / (tau_f - 1.0);
+        q.map(|v| k * v)
     }
 }
 
@@ -411,5 +465,53 @@ fn interp(line: &[Moments], i: usize) -> Moments {
     } else {
         let (b, c) = (line[k], line[k + 1]);
         std::array::from_fn(|n| 0.5 * (b[n] + c[n]))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lbm::collision::{collide_les, Relax};
+    use crate::lbm::lattice::Q;
+
+    /// A node of the simple shear flow `u = (gamma y, 0)` after a Smagorinsky collision with
+    /// `tau0`: before it, equilibrium plus the Chapman-Enskog stress `Pi_xy = -2 rho c_s^2 tau S_xy`
+    /// of the local relaxation time `tau = tau0 + a |S|`, `|S| = gamma / sqrt(2)`.
+    fn sheared(tau0: f64, gamma: f32, smagorinsky: f64) -> [f32; Q] {
+        let a = (18.0 * 2f64.sqrt() * smagorinsky * smagorinsky / 6.0) as f32;
+        let tau = tau0 as f32 + a * gamma / 2f32.sqrt();
+        let mut g = hermite_populations(0.0, 0.02, 0.0, [0.0, 0.0, -tau * gamma / 3.0]);
+        collide_les::<true, false, true>(&mut g, Relax::new(tau0, smagorinsky), 0.0, 0.0);
+        g
+    }
+
+    #[test]
+    fn the_stress_map_is_its_own_inverse_and_matches_the_strain_rate_ratio() {
+        for smagorinsky in [0.0, 0.1, 0.17] {
+            let (tau_c, tau_f) = (0.506, 0.512);
+            let map = StressMap::new(tau_c, tau_f, smagorinsky);
+            let q = [1.0e-4, -1.0e-4, 3.0e-3];
+            let back = map.to_coarse(1.0, map.to_fine(1.0, q));
+            for k in 0..3 {
+                assert!((back[k] - q[k]).abs() < 1e-6 * q[2].abs(), "C_s {smagorinsky}: {back:?} vs {q:?}");
+            }
+            // The strain rate read back on each side halves from coarse to fine.
+            let (s_c, _) = map.strain(1.0, q, tau_c as f32);
+            let (s_f, _) = map.strain(1.0, map.to_fine(1.0, q), tau_f as f32);
+            assert!((s_f / s_c - 0.5).abs() < 1e-4, "C_s {smagorinsky}: {s_c} -> {s_f}");
+        }
+    }
+
+    #[test]
+    fn the_strain_read_back_from_a_smagorinsky_collision_is_the_strain_put_in() {
+        // The collision's own local tau must be recovered from its post-collision stress.
+        for smagorinsky in [0.0, 0.1] {
+            let map = StressMap::new(0.506, 0.512, smagorinsky);
+            let g = sheared(0.506, 0.01, smagorinsky);
+            let (_, _, _, q) = crate::lbm::collision::hermite_stress(&g);
+            let (s, _) = map.strain(1.0, q, 0.506);
+            let expected = 0.01 / 2f32.sqrt();
+            assert!((s / expected - 1.0).abs() < 1e-5, "C_s {smagorinsky}: |S| {s} vs {expected}");
+        }
     }
 }
