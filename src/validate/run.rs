@@ -1,5 +1,6 @@
-//! Runs one validation case on the D2Q9 solver: plan (lattice numbers, refusals), spin-up and
-//! averaging, force history, final vorticity field.
+//! Runs one validation case on the D2Q9 solver (one uniform grid, or nested 2:1 patches around
+//! the bodies when the case has `[refinement]`): plan (lattice numbers, refusals), spin-up and
+//! averaging, force history (from the finest grid), final vorticity field (coarse grid).
 
 use std::sync::Arc;
 use std::time::Instant;
