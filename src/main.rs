@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 
-use hgym::bench::{bench_lbm, LbmBenchOptions};
+use hgym::bench::{bench_lbm, bench_refine, LbmBenchOptions, RefineBenchOptions};
 
 mod cli;
 use cli::progress::Progress;
@@ -202,6 +202,17 @@ enum BenchCommand {
         #[arg(long, value_enum, default_value = "regularized")]
         collision: CollisionArg,
     },
+    /// 2:1 grid refinement: node updates per second of a grid with a patch over its middle
+    /// quarter against the uniform kernel on the same grid, 1 and 2 threads. Exit 1 if the refined
+    /// rate is below 80 % of the uniform one with all threads.
+    Refine {
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+        /// A fast smoke run (a small grid, short timings; the target is not judged).
+        #[arg(long)]
+        quick: bool,
+    },
     /// Learner speed: TD3 updates/s (256x256, batch 256), PPO epochs/s (64x64), batch-1 policy
     /// latency, against SB3 measured on this machine. Exit 1 if short of the targets.
     Agents {
@@ -277,6 +288,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Validate(args) => run_validate(args),
         Command::Bench(BenchCommand::Lbm { json, quick, collision }) => run_bench(json, quick, collision),
+        Command::Bench(BenchCommand::Refine { json, quick }) => run_bench_refine(json, quick),
         Command::Bench(BenchCommand::Envs {
             json,
             actions,
@@ -469,6 +481,27 @@ fn run_bench(json: bool, quick: bool, collision: CollisionArg) -> Result<Outcome
     })
     .map_err(anyhow::Error::msg)
     .context("LBM benchmark")?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", report.table());
+    }
+    Ok(if report.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
+}
+
+fn run_bench_refine(json: bool, quick: bool) -> Result<Outcome> {
+    let mut opts = RefineBenchOptions::default();
+    if quick {
+        opts.n = 128;
+        opts.seconds = 0.05;
+    }
+    let report = bench_refine(&opts, &mut |msg| {
+        if !json {
+            eprintln!("{msg}");
+        }
+    })
+    .map_err(anyhow::Error::msg)
+    .context("refinement benchmark")?;
     if json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

@@ -378,6 +378,27 @@ fn bench_quick_reports_mlups_and_roofline_fraction() {
 }
 
 #[test]
+fn bench_refine_quick_reports_the_ratio_to_the_uniform_kernel() {
+    let o = hgym(&["bench", "refine", "--quick", "--json"]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    assert_eq!(v["schema"], "hgym/bench-refine/v1");
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    for r in rows {
+        let (uniform, refined) = (r["uniform_mlups"].as_f64().unwrap(), r["refined_mlups"].as_f64().unwrap());
+        assert!(uniform > 0.0 && refined > 0.0);
+        assert!((r["ratio"].as_f64().unwrap() - refined / uniform).abs() < 1e-9);
+        // 128^2 coarse nodes and the 129^2 fine nodes over the middle 64^2 cells, stepped twice.
+        assert_eq!(r["node_updates_per_step"], 128 * 128 + 2 * 129 * 129);
+        for e in r["check_error"].as_array().unwrap() {
+            assert!(e.as_f64().unwrap() < 0.01, "{out}");
+        }
+    }
+}
+
+#[test]
 fn bench_envs_times_only_the_families_asked_for() {
     let o = hgym(&["bench", "envs", "--family", "pinbal"]);
     let (_, err) = text(&o);

@@ -9,12 +9,17 @@
 //! The target (70 % of the roofline) is judged at the memory-bound size with all threads; the
 //! single-thread rows are reported beside it (one core is bound by arithmetic, not memory: its
 //! rate from memory matches its rate from the last-level cache).
+//!
+//! `hgym bench refine`: the cost of 2:1 grid refinement's coupling, as the ratio of a refined
+//! grid's node updates per second to the uniform kernel's on the same coarse grid, same run.
 
 pub mod agents;
 pub mod envs;
 pub mod kolmogorov;
 mod lbm;
+mod refine;
 mod stream;
 
 pub use lbm::{bench_lbm, BenchReport, BenchRow, LbmBenchOptions};
+pub use refine::{bench_refine, RefineBenchOptions, RefineBenchReport, RefineBenchRow};
 pub use stream::stream_copy_gbs;

@@ -376,21 +376,20 @@ fn write_ring(fine: &mut D2q9, c: &Coupling, theta: f32) {
     }
 }
 
-/// Gives every coarse node strictly inside the patch the moments of the fine node on it.
+/// Gives every coarse fluid node strictly inside the patch the moments of the fine node on it
+/// (rows in parallel; the same result for any thread count).
 fn restrict(coarse: &mut D2q9, fine: &D2q9, c: &Coupling) {
     let [x0, x1] = c.patch.x;
     let [y0, y1] = c.patch.y;
-    for y in y0 + 1..y1 {
-        for x in x0 + 1..x1 {
-            let (xf, yf) = (2 * (x - x0), 2 * (y - y0));
-            if fine.is_solid(xf, yf) || coarse.is_solid(x, y) {
-                continue;
-            }
-            let (d, ux, uy, q) = hermite_stress(&fine.node_populations(xf, yf));
-            let g = hermite_populations(d, ux, uy, c.convert.to_coarse(1.0 + d, q));
-            coarse.set_node_populations(x, y, &g);
+    let convert = c.convert;
+    coarse.overwrite_fluid_nodes(x0 + 1..x1, y0 + 1..y1, |x, y| {
+        let (xf, yf) = (2 * (x - x0), 2 * (y - y0));
+        if fine.is_solid(xf, yf) {
+            return None;
         }
-    }
+        let (d, ux, uy, q) = hermite_stress(&fine.node_populations(xf, yf));
+        Some(hermite_populations(d, ux, uy, convert.to_coarse(1.0 + d, q)))
+    });
 }
 
 /// Converts a post-collision non-equilibrium stress between a grid and its 2:1 patch.

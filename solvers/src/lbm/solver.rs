@@ -607,6 +607,33 @@ impl D2q9 {
         }
     }
 
+    /// Overwrites, rows in parallel, the shifted post-collision populations of every fluid node
+    /// `(x, y)` with `x` in `xs` and `y` in `ys` for which `g(x, y)` gives some (grid coupling:
+    /// the restriction of a refined patch). Every node is written once from a function of its
+    /// position alone, so the result is the same for any thread count. Allocates nothing.
+    pub fn overwrite_fluid_nodes(
+        &mut self,
+        xs: std::ops::Range<usize>,
+        ys: std::ops::Range<usize>,
+        g: impl Fn(usize, usize) -> Option<[f32; Q]> + Sync,
+    ) {
+        let nx = self.cfg.nx;
+        let (solid, y0, ny) = (&self.solid, ys.start, ys.len());
+        self.f.par_chunks_mut(Q * nx).skip(y0).take(ny).enumerate().for_each(|(k, row)| {
+            let y = y0 + k;
+            for x in xs.clone() {
+                if solid[y * nx + x] {
+                    continue;
+                }
+                if let Some(v) = g(x, y) {
+                    for (i, p) in v.iter().enumerate() {
+                        row[i * nx + x] = *p;
+                    }
+                }
+            }
+        });
+    }
+
     /// Density and (half-force-corrected) velocity of one node's shifted populations.
     #[inline(always)]
     fn density_velocity(&self, g: &[f32; Q]) -> (f32, f32, f32) {

@@ -1,0 +1,220 @@
+//! The grid-refinement benchmark: what the 2:1 coupling costs.
+//!
+//! A refined run steps every node of every level (level `l` twice per step of level `l - 1`)
+//! with the same kernel as a uniform grid, and adds the coupling: reading the parent's edge
+//! moments, rebuilding the patch's outer ring, and restricting the patch onto the parent's nodes
+//! under it. So the peer is the uniform D2Q9 kernel on the coarse grid, timed in the same run with
+//! the same threads: the ratio `refined node updates per second / uniform MLUPS` is 1 for free
+//! coupling, and `1 - ratio` is the coupling's share of the time.
+
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use hgym_solvers::lbm::{Collision, D2q9, D2q9Config, Patch, Refined, Sides};
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct RefineBenchRow {
+    pub threads: usize,
+    /// Coarse grid (periodic, `n x n`).
+    pub n: usize,
+    /// Nodes per coarse step: the coarse grid's plus twice the patch's.
+    pub node_updates_per_step: usize,
+    pub uniform_mlups: f64,
+    /// Refined node updates per second, in millions.
+    pub refined_mlups: f64,
+    /// `refined_mlups / uniform_mlups`.
+    pub ratio: f64,
+    /// Largest relative velocity error (coarse grid, patch) of the Taylor-Green vortex against its
+    /// exact decay after the timed steps.
+    pub check_error: [f64; 2],
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct RefineBenchReport {
+    pub schema: String,
+    pub collision: String,
+    pub rows: Vec<RefineBenchRow>,
+    /// Smallest ratio accepted with all threads.
+    pub target_ratio: f64,
+    pub pass: bool,
+    pub manifest: crate::report::manifest::Manifest,
+}
+
+#[derive(Clone, Debug)]
+pub struct RefineBenchOptions {
+    /// Coarse grid side; the patch covers the middle half of each direction (a quarter of the
+    /// area, so the patch has as many nodes as the coarse grid).
+    pub n: usize,
+    pub threads: Vec<usize>,
+    /// Seconds of timed stepping per measurement.
+    pub seconds: f64,
+}
+
+impl Default for RefineBenchOptions {
+    fn default() -> Self {
+        // 1024^2 coarse nodes (75 MB for the A-B pair) and as many on the patch: far beyond the
+        // last-level cache, like the validation runs.
+        RefineBenchOptions {
+            n: 1024,
+            threads: vec![1, 2],
+            seconds: 1.5,
+        }
+    }
+}
+
+const TAU: f64 = 0.6;
+const U0: f64 = 0.02;
+
+/// Taylor-Green vortex of wavelength `n / 4` coarse cells at coarse time `t`: `(rho, u, v)`, the
+/// density carrying the pressure `p = -u0^2 / 4 (cos 2kx + cos 2ky) e^{-4 nu k^2 t}` (`rho = 1 + 3 p`).
+fn vortex(n: usize, t: f64, x: f64, y: f64) -> (f64, f64, f64) {
+    let k = 8.0 * PI / n as f64;
+    let nu = (TAU - 0.5) / 3.0;
+    let d = (-2.0 * nu * k * k * t).exp();
+    let p = -0.25 * U0 * U0 * ((2.0 * k * x).cos() + (2.0 * k * y).cos()) * d * d;
+    (
+        1.0 + 3.0 * p,
+        -U0 * (k * x).cos() * (k * y).sin() * d,
+        U0 * (k * x).sin() * (k * y).cos() * d,
+    )
+}
+
+/// Largest velocity error of `grid` (positions `origin + i dx` in coarse units) on a 32 x 32
+/// sample, as a fraction of the initial amplitude.
+fn check(grid: &D2q9, origin: f64, dx: f64, n: usize, t: f64) -> f64 {
+    let mut err = 0.0f64;
+    for y in (0..grid.ny()).step_by((grid.ny() / 32).max(1)) {
+        for x in (0..grid.nx()).step_by((grid.nx() / 32).max(1)) {
+            let (_, u, v) = grid.node(x, y);
+            let (_, ue, ve) = vortex(n, t, origin + x as f64 * dx, origin + y as f64 * dx);
+            err = err.max((u as f64 - ue).abs().max((v as f64 - ve).abs()) / U0);
+        }
+    }
+    err
+}
+
+/// Steps `step` for about `seconds` (best of three timings after a calibration); returns steps
+/// per second.
+fn time_steps(seconds: f64, mut step: impl FnMut(u64) -> Result<(), String>) -> Result<f64, String> {
+    step(2)?;
+    let t = Instant::now();
+    step(2)?;
+    let per_step = t.elapsed().as_secs_f64() / 2.0;
+    let steps = ((seconds / 3.0 / per_step.max(1e-9)) as u64).max(2);
+    let mut dt = f64::INFINITY;
+    for _ in 0..3 {
+        let t = Instant::now();
+        step(steps)?;
+        dt = dt.min(t.elapsed().as_secs_f64());
+    }
+    Ok(steps as f64 / dt)
+}
+
+/// Runs the benchmark (regularised collision, the validation cases' operator).
+pub fn bench_refine(opts: &RefineBenchOptions, progress: &mut dyn FnMut(&str)) -> Result<RefineBenchReport, String> {
+    let n = opts.n;
+    if n < 64 || !n.is_multiple_of(16) {
+        return Err(format!("grid side {n}: use a multiple of 16, at least 64"));
+    }
+    let cfg = || {
+        let mut c = D2q9Config::new(n, n, TAU, Sides::periodic());
+        c.collision = Collision::Regularized;
+        c.check_interval = 0;
+        c
+    };
+    let patch = Patch {
+        x: [n / 4, 3 * n / 4],
+        y: [n / 4, 3 * n / 4],
+    };
+    let mut rows = Vec::new();
+    for &threads in &opts.threads {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| e.to_string())?;
+        let row = pool.install(|| -> Result<RefineBenchRow, String> {
+            let mut uniform = D2q9::new(cfg(), vec![]).map_err(|e| e.to_string())?;
+            uniform.init_with(|x, y| vortex(n, 0.0, x, y));
+            let uniform_rate = time_steps(opts.seconds, |k| uniform.advance(k).map_err(|e| e.to_string()))?;
+            let uniform_mlups = uniform_rate * (n * n) as f64 / 1e6;
+            drop(uniform);
+
+            let mut refined = Refined::new(cfg(), &[patch], vec![]).map_err(|e| e.to_string())?;
+            refined.init_with(|x, y| vortex(n, 0.0, x, y));
+            let rate = time_steps(opts.seconds, |k| refined.advance(k).map_err(|e| e.to_string()))?;
+            let updates = refined.node_updates_per_step();
+            let refined_mlups = rate * updates as f64 / 1e6;
+            let t = refined.time() as f64;
+            let check_error = [
+                check(refined.coarse(), 0.0, 1.0, n, t),
+                check(refined.fine(), patch.x[0] as f64, 0.5, n, t),
+            ];
+            Ok(RefineBenchRow {
+                threads,
+                n,
+                node_updates_per_step: updates,
+                uniform_mlups,
+                refined_mlups,
+                ratio: refined_mlups / uniform_mlups,
+                check_error,
+            })
+        })?;
+        if row.check_error.iter().any(|e| *e > 0.01) {
+            return Err(format!(
+                "correctness check failed: Taylor-Green velocity off by {:.2e} (coarse) / {:.2e} (patch) of its amplitude",
+                row.check_error[0], row.check_error[1]
+            ));
+        }
+        progress(&format!(
+            "{threads} thread(s): uniform {:.0} MLUPS, refined {:.0} MLUPS ({:.0} %)",
+            row.uniform_mlups,
+            row.refined_mlups,
+            100.0 * row.ratio
+        ));
+        rows.push(row);
+    }
+    let target = 0.8;
+    let max_threads = rows.iter().map(|r| r.threads).max().unwrap_or(1);
+    let pass = rows.iter().filter(|r| r.threads == max_threads).all(|r| r.ratio >= target);
+    Ok(RefineBenchReport {
+        schema: "hgym/bench-refine/v1".into(),
+        collision: Collision::Regularized.name().into(),
+        rows,
+        target_ratio: target,
+        pass,
+        manifest: crate::report::manifest::manifest(max_threads, 0.0),
+    })
+}
+
+impl RefineBenchReport {
+    pub fn table(&self) -> String {
+        let mut s = format!(
+            "D2Q9 with a 2:1 patch over the middle quarter ({} collision); peer: the uniform coarse grid, same run, same threads\n",
+            self.collision
+        );
+        s += &format!(
+            "  {:>7} {:>11} {:>13} {:>14} {:>14} {:>7}  {}\n",
+            "threads", "coarse", "updates/step", "uniform MLUPS", "refined MLUPS", "ratio", "check"
+        );
+        for r in &self.rows {
+            s += &format!(
+                "  {:>7} {:>11} {:>13} {:>14.1} {:>14.1} {:>6.0}%  TG err {:.1e} / {:.1e}\n",
+                r.threads,
+                format!("{}x{}", r.n, r.n),
+                r.node_updates_per_step,
+                r.uniform_mlups,
+                r.refined_mlups,
+                100.0 * r.ratio,
+                r.check_error[0],
+                r.check_error[1]
+            );
+        }
+        s += &format!(
+            "  target: refined >= {:.0}% of the uniform rate with all threads: {}\n",
+            100.0 * self.target_ratio,
+            if self.pass { "met" } else { "NOT met" }
+        );
+        s
+    }
+}
