@@ -23,6 +23,7 @@ step validate-pinball  "$HGYM" validate pinball --level default
 step validate-square   "$HGYM" validate square --level default
 step validate-kolmogorov "$HGYM" validate kolmogorov
 step bench-lbm        "$HGYM" bench lbm
+step bench-refine     "$HGYM" bench refine
 step bench-agents     "$HGYM" bench agents
 step bench-kolmogorov "$HGYM" bench kolmogorov
 step bench-envs       "$HGYM" bench envs --quick

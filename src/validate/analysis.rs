@@ -12,7 +12,8 @@
 //! tallest peak: the fluidic pinball's total lift at Re 100 has its third harmonic above its
 //! fundamental, as the lifts of the three cylinders partly cancel. The spectral estimate is
 //! therefore the lowest peak of at least a quarter of the tallest one of which the tallest is a
-//! harmonic (2nd to 6th, within 3 %), and the crossings are counted on the lift low-passed by two
+//! harmonic (2nd to 6th, within 3 %) and every other such peak a multiple (a periodic signal's
+//! spectrum; a broadband one keeps its tallest peak), and the crossings are counted on the lift low-passed by two
 //! centred moving averages over a half and a third of that period, which null the 2nd and 3rd
 //! harmonics (and their multiples) and leave the timing of the fundamental's crossings unchanged.
 //! The level crossed is the lift's centred moving average over one period (which nulls the
@@ -77,18 +78,31 @@ fn refined_peak(freqs: &[f64], amps: &[f64], k: usize) -> f64 {
 }
 
 /// The fundamental frequency of the spectrum (see the module doc): the lowest local maximum of at
-/// least a quarter of the tallest peak whose 2nd to 6th multiple lies within 3 % of the tallest,
-/// else the tallest.
+/// least a quarter of the tallest peak whose 2nd to 6th multiple lies within 3 % of the tallest
+/// and of which every such substantial peak is a multiple (within 3 %), else the tallest. The
+/// second condition keeps a broadband (chaotic) lift from being read as periodic: the square
+/// cylinder at Re 1000 with its lattice velocity halved has its tallest peak at 0.102 and
+/// substantial ones at 0.052 and 0.075; 0.052 is half of 0.102 but 0.075 is no multiple of it,
+/// and taking 0.052 smoothed the crossings away (no Strouhal number at all).
 fn spectral_fundamental(freqs: &[f64], amps: &[f64]) -> Option<f64> {
     if amps.len() < 3 {
         return None;
     }
     let top = (1..amps.len() - 1).max_by(|&a, &b| amps[a].total_cmp(&amps[b]))?;
     let f_top = refined_peak(freqs, amps, top);
-    let fundamental = (1..top)
+    let peaks: Vec<f64> = (1..amps.len() - 1)
         .filter(|&k| amps[k] >= 0.25 * amps[top] && amps[k] >= amps[k - 1] && amps[k] >= amps[k + 1])
         .map(|k| refined_peak(freqs, amps, k))
-        .find(|&f| (2..=6).any(|m| (m as f64 * f - f_top).abs() <= 0.03 * f_top));
+        .collect();
+    let multiple_of = |f: f64, base: f64| {
+        let m = (f / base).round();
+        m >= 1.0 && (m * base - f).abs() <= 0.03 * f
+    };
+    let fundamental = peaks
+        .iter()
+        .copied()
+        .filter(|&f| f < f_top)
+        .find(|&f| (2..=6).any(|m| (m as f64 * f - f_top).abs() <= 0.03 * f_top) && peaks.iter().all(|&p| multiple_of(p, f)));
     Some(fundamental.unwrap_or(f_top))
 }
 
@@ -294,6 +308,31 @@ mod tests {
         let a = analyse(&t, &cd, &cl, 10.0);
         assert!((a.strouhal.unwrap() - st).abs() < 1e-3, "{:?}", a.strouhal);
         assert!(a.periods >= 65, "{} periods in {:?}", a.periods, a.window);
+    }
+
+    /// A broadband lift like the square cylinder's at Re 1000 (its measured spectrum's peaks:
+    /// 0.102 tallest, 0.075, 0.052, 0.14, 0.195): 0.052 is half the tallest, but the other
+    /// peaks are no multiples of it, so the tallest is the frequency and the crossings count it.
+    #[test]
+    fn a_subharmonic_of_a_broadband_lift_is_not_taken_for_the_fundamental() {
+        let dt = 0.01;
+        let t: Vec<f64> = (0..18_000).map(|j| j as f64 * dt).collect();
+        let tau = 2.0 * std::f64::consts::PI;
+        let tones = [
+            (0.102, 0.92, 0.0),
+            (0.075, 0.83, 1.1),
+            (0.052, 0.57, 2.3),
+            (0.14, 0.72, 0.4),
+            (0.195, 0.55, 1.7),
+        ];
+        let cl: Vec<f64> = t
+            .iter()
+            .map(|t| tones.iter().map(|(f, a, p)| a * (tau * f * t + p).sin()).sum())
+            .collect();
+        let cd = vec![2.4; t.len()];
+        let a = analyse(&t, &cd, &cl, 60.0);
+        assert!((a.strouhal_spectral.unwrap() - 0.102).abs() < 3e-3, "{:?}", a.strouhal_spectral);
+        assert!(a.strouhal.is_some() && a.periods >= 5, "{a:?}");
     }
 
     #[test]
