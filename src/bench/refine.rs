@@ -53,10 +53,13 @@ pub struct RefineBenchOptions {
 
 impl Default for RefineBenchOptions {
     fn default() -> Self {
-        // 1024^2 coarse nodes (75 MB for the A-B pair) and as many on the patch: far beyond the
-        // last-level cache, like the validation runs.
+        // 1008^2 coarse nodes (73 MB for the A-B pair) and about as many on the patch: far beyond the
+        // last-level cache, like the validation runs. Not 1024: rows of 1024-1026 floats per
+        // population put the kernel's load and store streams 4 KiB apart (4K aliasing; measured
+        // plain-store rates at 1 thread: 82, 85, 96 MLUPS at nx 1024, 1025, 1026 against 118-139
+        // at 1027-1049), so a 1024 grid's 1025-wide patch would time the aliasing, not the coupling.
         RefineBenchOptions {
-            n: 1024,
+            n: 1008,
             threads: vec![1, 2],
             seconds: 1.5,
         }

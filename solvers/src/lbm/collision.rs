@@ -208,7 +208,7 @@ pub fn collide_les<const REG: bool, const FORCED: bool, const LES: bool>(g: &mut
 /// non-equilibrium stress of shifted populations: `Pi^neq = sum_i c_i c_i (g_i - g_i^eq)` as
 /// `[xx, yy, xy]`. Applied to post-collision populations of the regularised operator it returns
 /// the stress it relaxed to, `(1 - omega) Pi^neq` (trace relaxed by [`OMEGA_BULK`]).
-#[inline]
+#[inline(always)]
 pub fn hermite_stress(g: &[f32; Q]) -> (f32, f32, f32, [f32; 3]) {
     let (drho, jx, jy) = moments(g);
     let inv_rho = 1.0 / (1.0 + drho);

@@ -434,6 +434,11 @@ impl StressMap {
     /// Coarse post-collision stress to the fine grid's.
     #[inline]
     fn to_fine(self, rho: f32, q: [f32; 3]) -> [f32; 3] {
+        if self.a == 0.0 {
+            // The same arithmetic as below with s gone: no square root per node.
+            let k = (self.tau_f - 1.0) / (2.0 * (self.tau_c - 1.0));
+            return q.map(|v| k * v);
+        }
         let (s, tau_c) = self.strain(rho, q, self.tau_c);
         let tau_f = self.tau_f + self.a * 0.5 * s;
         let k = (tau_f - 1.0) / (2.0 * (tau_c - 1.0));
@@ -443,6 +448,10 @@ impl StressMap {
     /// Fine post-collision stress to the coarse grid's.
     #[inline]
     fn to_coarse(self, rho: f32, q: [f32; 3]) -> [f32; 3] {
+        if self.a == 0.0 {
+            let k = 2.0 * (self.tau_c - 1.0) / (self.tau_f - 1.0);
+            return q.map(|v| k * v);
+        }
         let (s, tau_f) = self.strain(rho, q, self.tau_f);
         let tau_c = self.tau_c + self.a * 2.0 * s;
         let k = 2.0 * (tau_c - 1.0) / (tau_f - 1.0);
