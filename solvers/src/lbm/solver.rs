@@ -607,31 +607,24 @@ impl D2q9 {
         }
     }
 
-    /// Overwrites, rows in parallel, the shifted post-collision populations of every fluid node
-    /// `(x, y)` with `x` in `xs` and `y` in `ys` for which `g(x, y)` gives some (grid coupling:
-    /// the restriction of a refined patch). Every node is written once from a function of its
-    /// position alone, so the result is the same for any thread count. Allocates nothing.
-    pub fn overwrite_fluid_nodes(
-        &mut self,
-        xs: std::ops::Range<usize>,
-        ys: std::ops::Range<usize>,
-        g: impl Fn(usize, usize) -> Option<[f32; Q]> + Sync,
-    ) {
+    /// Rewrites rows `ys` of the shifted post-collision populations, rows in parallel (grid
+    /// coupling: the restriction of a refined patch): `rewrite(y, solid, row)` gets row `y`'s
+    /// solid flags (`solid[x]`) and populations (`row[i * nx + x]`, population `i` of node `x`).
+    /// A row's new values must depend on its position and the inputs alone, so the result is
+    /// the same for any thread count. Allocates nothing.
+    pub fn rewrite_rows(&mut self, ys: std::ops::Range<usize>, rewrite: impl Fn(usize, &[bool], &mut [f32]) + Sync) {
         let nx = self.cfg.nx;
         let (solid, y0, ny) = (&self.solid, ys.start, ys.len());
         self.f.par_chunks_mut(Q * nx).skip(y0).take(ny).enumerate().for_each(|(k, row)| {
             let y = y0 + k;
-            for x in xs.clone() {
-                if solid[y * nx + x] {
-                    continue;
-                }
-                if let Some(v) = g(x, y) {
-                    for (i, p) in v.iter().enumerate() {
-                        row[i * nx + x] = *p;
-                    }
-                }
-            }
+            rewrite(y, &solid[y * nx..(y + 1) * nx], row);
         });
+    }
+
+    /// Row `y`'s solid flags (`[x]`) and shifted post-collision populations (`[i * nx + x]`).
+    pub fn row(&self, y: usize) -> (&[bool], &[f32]) {
+        let nx = self.cfg.nx;
+        (&self.solid[y * nx..(y + 1) * nx], &self.f[y * Q * nx..(y + 1) * Q * nx])
     }
 
     /// Density and (half-force-corrected) velocity of one node's shifted populations.
