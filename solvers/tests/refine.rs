@@ -1,6 +1,7 @@
-//! Two-level grid refinement: a uniform flow stays uniform, a Taylor-Green vortex decays at the
-//! analytic rate through the interface, and a cylinder in a channel (Schäfer & Turek's 2D-1
-//! benchmark) on a coarse grid with a fine patch matches the uniformly fine grid.
+//! 2:1 grid refinement (one and two nested patches): a uniform flow stays uniform, a Taylor-Green
+//! vortex decays at the analytic rate through the interfaces, a cylinder in a channel (Schäfer &
+//! Turek's 2D-1 benchmark) on a coarse grid with a fine patch matches the uniformly fine grid,
+//! unusable patches are refused, and results do not depend on the thread count.
 
 use std::f64::consts::PI;
 use std::sync::Arc;

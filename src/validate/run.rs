@@ -87,7 +87,7 @@ pub struct Plan {
     pub collision: Collision,
     pub spin_up_steps: u64,
     pub total_steps: u64,
-    /// The fine patch, if the case has a `[refinement]` region.
+    /// The nested patches, if the case has `[refinement]` regions.
     pub refinement: Option<RefinementPlan>,
 }
 
@@ -362,7 +362,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     })
 }
 
-/// The grid(s) a case runs on: one uniform grid, or a coarse grid with a fine patch.
+/// The grid(s) a case runs on: one uniform grid, or a coarse grid with nested 2:1 patches.
 enum Grids {
     Uniform(Box<D2q9>),
     Refined(Refined),
@@ -376,7 +376,7 @@ impl Grids {
         }
     }
 
-    /// Forces on the bodies in the level's lattice units (from the patch when refined).
+    /// Forces on the bodies in the level's lattice units (from the finest patch when refined).
     fn body_forces(&self) -> &[[f64; 2]] {
         match self {
             Grids::Uniform(s) => s.body_forces(),

@@ -28,8 +28,8 @@
 //! refinement run at `tau` close to 1/2. BGK runs too: the interface keeps only the Hermite part
 //! of its non-equilibrium populations.
 //!
-//! Bodies live on the fine grid (forces come from there); the coarse grid marks them solid too,
-//! but its nodes near them are overwritten each step. Sponges and domain edges stay on the coarse
+//! Bodies live on the finest grid (forces come from there); the coarser grids mark them solid
+//! too, but their nodes near them are overwritten each step. Sponges and domain edges stay on the coarse
 //! grid; the patch must stay clear of them. The coupling conserves mass only to the truncation
 //! error of the interpolation (no flux correction), as in Lagrava et al.
 
