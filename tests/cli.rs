@@ -274,6 +274,9 @@ fn pinball_forces_match_hydrogym_firedrake_steady_solution() {
     assert!((value("mean_cl_2") + value("mean_cl_3")).abs() < 1e-4);
     assert!(value("mean_cl_1").abs() < 1e-3);
     schema_check(&report);
+    // Three bodies: the history has their drags and lifts beside the totals.
+    let csv = std::fs::read_to_string(dir.path().join("pinball_re30_steady/forces.csv")).unwrap();
+    assert_eq!(csv.lines().next(), Some("t,c_d,c_l,c_d_1,c_l_1,c_d_2,c_l_2,c_d_3,c_l_3"));
 }
 
 #[test]
@@ -335,6 +338,25 @@ fn an_unseen_case_file_runs_and_passes() {
     for plot in ["forces.png", "spectrum.png", "vorticity.png"] {
         assert!(out.join("schaefer_turek_2d1").join(plot).exists());
     }
+    // The force history re-analyses to the report: its mean drag over the report's window.
+    let csv = std::fs::read_to_string(out.join("schaefer_turek_2d1/forces.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("t,c_d,c_l"));
+    let rows: Vec<Vec<f64>> = lines.map(|l| l.split(',').map(|v| v.parse().unwrap()).collect()).collect();
+    let t_end = report["parameters"]["spin_up"].as_f64().unwrap() + report["parameters"]["average"].as_f64().unwrap();
+    assert!(
+        (rows.last().unwrap()[0] - t_end).abs() < 0.02,
+        "history ends at {}",
+        rows.last().unwrap()[0]
+    );
+    let spacing = rows[1][0] - rows[0][0];
+    assert!(spacing > 0.0 && spacing <= 0.01 + 1e-9, "{spacing}");
+    let window = report["analysis"]["window"].as_array().unwrap();
+    let (t0, t1) = (window[0].as_f64().unwrap(), window[1].as_f64().unwrap());
+    let in_window: Vec<f64> = rows.iter().filter(|r| r[0] >= t0 && r[0] <= t1).map(|r| r[1]).collect();
+    let mean = in_window.iter().sum::<f64>() / in_window.len() as f64;
+    let reported = measured(&report, "mean_cd");
+    assert!((mean - reported).abs() < 1e-3 * reported, "csv mean {mean}, report {reported}");
 }
 
 #[test]

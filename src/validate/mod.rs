@@ -4,14 +4,16 @@
 //! [`validate_case`] plans the case at a resolution level (refusing what cannot run), runs the
 //! solver, analyses the force history over whole shedding periods, compares each quantity with
 //! its reference and tolerance, and writes `<out>/<case>.json` (shape:
-//! `schemas/validation.schema.json`) and plots in `<out>/<case>/`. A diverged run still writes
-//! its report and the plots up to the failure.
+//! `schemas/validation.schema.json`), plots and the force history (`forces.csv`, see [`series`])
+//! in `<out>/<case>/`. A diverged run still writes its report, the plots and the history up to
+//! the failure.
 
 pub mod analysis;
 pub mod case;
 pub mod kolmogorov;
 pub mod report;
 pub mod run;
+pub mod series;
 
 use std::path::{Path, PathBuf};
 
@@ -95,6 +97,8 @@ fn write_outputs(report: &ValidationReport, output: &run::RunOutput, out: &Path)
     let dir = out.join(&report.case);
     std::fs::create_dir_all(&dir).map_err(|e| out_err(&dir)(e.to_string()))?;
     report::write_plots(report, output, &dir).map_err(out_err(&dir))?;
+    let csv = dir.join("forces.csv");
+    series::write_forces_csv(output, &csv).map_err(out_err(&csv))?;
     let json_path = out.join(format!("{}.json", report.case));
     let text = serde_json::to_string_pretty(report).map_err(|e| out_err(&json_path)(e.to_string()))?;
     std::fs::write(&json_path, text + "\n").map_err(|e| out_err(&json_path)(e.to_string()))?;
