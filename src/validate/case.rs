@@ -271,6 +271,12 @@ pub struct InletSpec {
     /// Smooth ramp of the inlet from 0 to full speed over this time (0: impulsive start).
     #[serde(default)]
     pub ramp: f64,
+    /// Non-reflecting (characteristic) inlet: the inflow's normal velocity follows outgoing
+    /// pressure waves, `u_n = U - c_s (rho - rho_ref)`, with `rho_ref` the inlet's mean density
+    /// averaged over this time (L/U); 0 (the default) keeps the rigid velocity inlet, which
+    /// reflects them. See `hgym_solvers::lbm::boundary::InletReference`.
+    #[serde(default)]
+    pub characteristic_time: f64,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -535,6 +541,13 @@ impl LoadedCase {
         }
         if c.inlet.ramp < 0.0 || !c.inlet.ramp.is_finite() {
             return Err(bad(name, "inlet.ramp", "must be zero or a positive time"));
+        }
+        if c.inlet.characteristic_time < 0.0 || !c.inlet.characteristic_time.is_finite() {
+            return Err(bad(
+                name,
+                "inlet.characteristic_time",
+                "must be zero (a rigid inlet) or a positive time in L/U, e.g. 20",
+            ));
         }
         for (i, sp) in c.sponge.iter().enumerate() {
             if c.sponge[..i].iter().any(|o| o.edge == sp.edge) {

@@ -269,6 +269,10 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     cfg.grid = grid;
     cfg.check_interval = 200;
     cfg.sponges = case.sponge.iter().map(|sp| sp.lattice(n, u)).collect();
+    let steps_per_time = n / u;
+    if case.inlet.characteristic_time > 0.0 {
+        cfg.characteristic_inlet = Some(case.inlet.characteristic_time * steps_per_time);
+    }
     let bodies: Vec<_> = std::iter::once(&case.geometry).chain(&case.more_bodies).map(build_shape).collect();
     let n_bodies = bodies.len();
     let built = match &plan.refinement {
@@ -298,7 +302,6 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
         (1.0, start_u * inlet_u(y), kick * (-4.0 * r2).exp())
     });
 
-    let steps_per_time = n / u;
     let total = plan.total_steps;
     let mut t = Vec::with_capacity(total as usize);
     let mut cd = Vec::with_capacity(total as usize);

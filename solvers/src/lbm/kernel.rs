@@ -6,7 +6,7 @@
 //! on the list of specials (domain edges, nodes with a link into a body, solid nodes) then run the
 //! general path, which reads in order: load, boundaries, moments, collide, store.
 
-use super::boundary::{bouzidi, side_value};
+use super::boundary::{bouzidi, side_value, InletReference};
 use super::collision::{collide_les, Collision, Relax};
 use super::domain::Sides;
 use super::lattice::{CX, CY, Q};
@@ -49,6 +49,9 @@ pub(crate) struct KernelCtx<'a> {
     pub row_start: &'a [u32],
     pub links: &'a [Link],
     pub velocity_scale: f32,
+    /// Characteristic (non-reflecting) velocity edges: their reference densities; `None` for
+    /// rigid ones.
+    pub inlet_reference: Option<InletReference>,
     /// Write the interior with non-temporal stores (arrays larger than the caches).
     pub stream_stores: bool,
 }

@@ -5,6 +5,7 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use super::aligned::AlignedVec;
+use super::boundary::InletReference;
 use super::check::{scan_row, RowStat};
 use super::collision::{equilibrium, moments, Collision, Relax};
 use super::domain::{Edge, Grid, Side, Sides};
@@ -43,6 +44,10 @@ pub struct D2q9Config {
     pub stream_stores: Option<bool>,
     /// Absorbing layers along edges (none by default), see [`super::sponge`].
     pub sponges: Vec<Sponge>,
+    /// Make every [`Side::Velocity`] edge non-reflecting for pressure waves (see
+    /// [`super::boundary::InletReference`]), its reference density averaged over this many
+    /// steps; `None` (the default) keeps the rigid velocity edge.
+    pub characteristic_inlet: Option<f64>,
 }
 
 impl D2q9Config {
@@ -62,6 +67,7 @@ impl D2q9Config {
             u_max: 0.5,
             stream_stores: None,
             sponges: Vec::new(),
+            characteristic_inlet: None,
         }
     }
 }
@@ -95,6 +101,7 @@ pub struct D2q9 {
     row_stats: Vec<RowStat>,
     sponges: Vec<SpongePlan>,
     velocity_scale: f32,
+    inlet_reference: Option<InletReference>,
     time: u64,
 }
 
@@ -120,6 +127,7 @@ fn kernel_ctx<'a>(
     row_start: &'a [u32],
     links: &'a [Link],
     velocity_scale: f32,
+    inlet_reference: Option<InletReference>,
 ) -> KernelCtx<'a> {
     KernelCtx {
         nx: cfg.nx,
@@ -135,6 +143,7 @@ fn kernel_ctx<'a>(
         row_start,
         links,
         velocity_scale,
+        inlet_reference,
         stream_stores: cfg.stream_stores.unwrap_or(cfg.nx * cfg.ny * Q * 4 * 2 > STREAM_STORES_ABOVE_BYTES),
     }
 }
@@ -369,6 +378,7 @@ impl D2q9 {
             row_stats: vec![RowStat::default(); ny],
             sponges: cfg.sponges.iter().map(SpongePlan::new).collect(),
             velocity_scale: 1.0,
+            inlet_reference: cfg.characteristic_inlet.map(InletReference::new),
             time: 0,
             cfg,
         };
@@ -396,6 +406,16 @@ impl D2q9 {
         }
         self.f_next.copy_from_slice(&self.f);
         self.time = 0;
+        if let Some(r) = &mut self.inlet_reference {
+            r.reset(&self.cfg.sides, &self.f, &self.solid, nx, ny);
+        }
+    }
+
+    /// Advances the characteristic inlets' reference densities by one step (if there are any).
+    fn update_inlet_reference(&mut self) {
+        if let Some(r) = &mut self.inlet_reference {
+            r.update(&self.cfg.sides, &self.f, &self.solid, self.cfg.nx, self.cfg.ny);
+        }
     }
 
     /// Advances one time step. Allocates nothing.
@@ -408,6 +428,7 @@ impl D2q9 {
             &self.row_start,
             &self.links,
             self.velocity_scale,
+            self.inlet_reference,
         );
         let src = &self.f;
         let row_len = Q * self.cfg.nx;
@@ -422,6 +443,7 @@ impl D2q9 {
         link_forces(&ctx, src, &mut self.body_forces);
         std::mem::swap(&mut self.f, &mut self.f_next);
         self.time += 1;
+        self.update_inlet_reference();
 
         for (b, force) in self.body_forces.iter().enumerate() {
             if !force[0].is_finite() || !force[1].is_finite() {
@@ -703,6 +725,7 @@ impl D2q9 {
             &self.row_start,
             &self.links,
             self.velocity_scale,
+            self.inlet_reference,
         );
         let forced = self.cfg.body_force != [0.0, 0.0];
         let row_len = Q * self.cfg.nx;
@@ -714,6 +737,7 @@ impl D2q9 {
         link_forces(&ctx, &self.f, &mut self.body_forces);
         std::mem::swap(&mut self.f, &mut self.f_next);
         self.time += 1;
+        self.update_inlet_reference();
         Ok(())
     }
 

@@ -58,6 +58,10 @@ pub(crate) fn side_value(c: &KernelCtx, src: &[f32], x: usize, y: usize, k: usiz
                 *gi = src[c.idx(x, y, i)];
             }
             let rho = 1.0 + moments(&g).0;
+            let (ux, uy) = match &c.inlet_reference {
+                Some(r) => r.velocity(edge, rho, ux, uy),
+                None => (ux, uy),
+            };
             src[c.idx(x, y, OPP[k])] + 6.0 * W[k] * rho * (CX[k] as f32 * ux + CY[k] as f32 * uy)
         }
         Side::FreeSlip => {
