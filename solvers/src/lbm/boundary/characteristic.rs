@@ -95,15 +95,18 @@ fn edge_mean_density(sides: &Sides, edge: Edge, f: &[f32], solid: &[bool], nx: u
     if !matches!(sides.get(edge), Side::Velocity { .. }) {
         return None;
     }
-    let (len, node): (usize, fn(usize, usize, usize) -> (usize, usize)) = match edge {
-        Edge::West => (ny, |i, _, _| (0, i)),
-        Edge::East => (ny, |i, nx, _| (nx - 1, i)),
-        Edge::South => (nx, |i, _, _| (i, 0)),
-        Edge::North => (nx, |i, _, ny| (i, ny - 1)),
+    let len = match edge {
+        Edge::West | Edge::East => ny,
+        Edge::South | Edge::North => nx,
     };
     let (mut sum, mut n) = (0.0f64, 0usize);
     for i in 0..len {
-        let (x, y) = node(i, nx, ny);
+        let (x, y) = match edge {
+            Edge::West => (0, i),
+            Edge::East => (nx - 1, i),
+            Edge::South => (i, 0),
+            Edge::North => (i, ny - 1),
+        };
         if solid[y * nx + x] {
             continue;
         }
