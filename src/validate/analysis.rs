@@ -39,6 +39,9 @@ pub struct Analysis {
     pub periods: usize,
     /// Time window the means are taken over `[t0, t1]`.
     pub window: [f64; 2],
+    /// The lift spectrum's substantial peaks (see [`lift_peaks`]): `[frequency, height relative
+    /// to the tallest]`, tallest first.
+    pub lift_peaks: Vec<[f64; 2]>,
 }
 
 /// The lift spectrum over the window: `(frequencies, amplitudes)`.
@@ -77,6 +80,48 @@ fn refined_peak(freqs: &[f64], amps: &[f64], k: usize) -> f64 {
     freqs[k] + shift.clamp(-0.5, 0.5) * df
 }
 
+/// Local maxima of at least a quarter of the tallest: `(refined frequency, amplitude)`, tallest
+/// first.
+fn substantial_peaks(freqs: &[f64], amps: &[f64]) -> Vec<(f64, f64)> {
+    if amps.len() < 3 {
+        return vec![];
+    }
+    let Some(top) = (1..amps.len() - 1).max_by(|&a, &b| amps[a].total_cmp(&amps[b])) else {
+        return vec![];
+    };
+    let mut peaks: Vec<(f64, f64)> = (1..amps.len() - 1)
+        .filter(|&k| amps[k] >= 0.25 * amps[top] && amps[k] >= amps[k - 1] && amps[k] >= amps[k + 1])
+        .map(|k| (refined_peak(freqs, amps, k), amps[k]))
+        .collect();
+    peaks.sort_by(|a, b| b.1.total_cmp(&a.1));
+    peaks
+}
+
+/// The most peaks [`lift_peaks`] lists.
+pub const MAX_PEAKS: usize = 8;
+
+/// Whether `f` is a whole multiple of `base` within 3 %.
+fn multiple_of(f: f64, base: f64) -> bool {
+    let m = (f / base).round();
+    m >= 1.0 && (m * base - f).abs() <= 0.03 * f
+}
+
+/// The lift spectrum's substantial peaks, `[frequency, height / tallest height]`, tallest first
+/// (at most [`MAX_PEAKS`]): what a reader needs to tell a limit cycle (the fundamental and its
+/// harmonics) from a broadband, chaotic wake (peaks at unrelated frequencies) without re-running
+/// the case.
+pub fn lift_peaks(freqs: &[f64], amps: &[f64]) -> Vec<[f64; 2]> {
+    let peaks = substantial_peaks(freqs, amps);
+    let top = peaks.first().map_or(1.0, |p| p.1);
+    peaks.iter().take(MAX_PEAKS).map(|&(f, a)| [f, a / top]).collect()
+}
+
+/// Whether every listed peak is a harmonic (a whole multiple, within 3 %) of `fundamental`: a
+/// periodic lift. A broadband one has peaks between the harmonics.
+pub fn is_harmonic_series(peaks: &[[f64; 2]], fundamental: f64) -> bool {
+    fundamental > 0.0 && peaks.iter().all(|p| multiple_of(p[0], fundamental))
+}
+
 /// The fundamental frequency of the spectrum (see the module doc): the lowest local maximum of at
 /// least a quarter of the tallest peak whose 2nd to 6th multiple lies within 3 % of the tallest
 /// and of which every such substantial peak is a multiple (within 3 %), else the tallest. The
@@ -85,24 +130,13 @@ fn refined_peak(freqs: &[f64], amps: &[f64], k: usize) -> f64 {
 /// substantial ones at 0.052 and 0.075; 0.052 is half of 0.102 but 0.075 is no multiple of it,
 /// and taking 0.052 smoothed the crossings away (no Strouhal number at all).
 fn spectral_fundamental(freqs: &[f64], amps: &[f64]) -> Option<f64> {
-    if amps.len() < 3 {
-        return None;
-    }
-    let top = (1..amps.len() - 1).max_by(|&a, &b| amps[a].total_cmp(&amps[b]))?;
-    let f_top = refined_peak(freqs, amps, top);
-    let peaks: Vec<f64> = (1..amps.len() - 1)
-        .filter(|&k| amps[k] >= 0.25 * amps[top] && amps[k] >= amps[k - 1] && amps[k] >= amps[k + 1])
-        .map(|k| refined_peak(freqs, amps, k))
-        .collect();
-    let multiple_of = |f: f64, base: f64| {
-        let m = (f / base).round();
-        m >= 1.0 && (m * base - f).abs() <= 0.03 * f
-    };
-    let fundamental = peaks
-        .iter()
-        .copied()
-        .filter(|&f| f < f_top)
-        .find(|&f| (2..=6).any(|m| (m as f64 * f - f_top).abs() <= 0.03 * f_top) && peaks.iter().all(|&p| multiple_of(p, f)));
+    let peaks = substantial_peaks(freqs, amps);
+    let f_top = peaks.first()?.0;
+    let mut lower: Vec<f64> = peaks.iter().map(|p| p.0).filter(|&f| f < f_top).collect();
+    lower.sort_by(f64::total_cmp);
+    let fundamental = lower
+        .into_iter()
+        .find(|&f| (2..=6).any(|m| (m as f64 * f - f_top).abs() <= 0.03 * f_top) && peaks.iter().all(|p| multiple_of(p.0, f)));
     Some(fundamental.unwrap_or(f_top))
 }
 
@@ -139,6 +173,7 @@ pub fn analyse(t: &[f64], cd: &[f64], cl: &[f64], t_start: f64) -> Analysis {
     let hyst = 0.1 * std;
     let (freqs, amps) = spectrum(t, cl);
     let strouhal_spectral = if std > 1e-9 { spectral_fundamental(&freqs, &amps) } else { None };
+    let peaks = if std > 1e-9 { lift_peaks(&freqs, &amps) } else { vec![] };
     // Crossings are found on the lift low-passed by centred moving averages over a half and a
     // third of the fundamental period (see the module doc), so that harmonics and high-frequency
     // noise cannot add crossings; means and amplitudes use the raw signal.
@@ -195,6 +230,7 @@ pub fn analyse(t: &[f64], cd: &[f64], cl: &[f64], t_start: f64) -> Analysis {
             cd_amplitude: amp_d / periods as f64,
             periods,
             window: [t0, t1],
+            lift_peaks: peaks,
         }
     } else {
         let (lo, hi) = cl
@@ -213,6 +249,7 @@ pub fn analyse(t: &[f64], cd: &[f64], cl: &[f64], t_start: f64) -> Analysis {
             cd_amplitude: 0.5 * (dhi - dlo),
             periods: 0,
             window: [t[0], t[n - 1]],
+            lift_peaks: peaks,
         }
     }
 }
@@ -275,6 +312,10 @@ mod tests {
         assert!((a.strouhal.unwrap() - st).abs() < 1e-3, "{:?}", a.strouhal);
         assert!((a.strouhal_spectral.unwrap() - st).abs() < 2e-3, "{:?}", a.strouhal_spectral);
         assert!((a.mean_cl - 0.03).abs() < 1e-4, "{}", a.mean_cl);
+        // The third harmonic is the tallest peak, and the three make a harmonic series.
+        assert_eq!(a.lift_peaks.len(), 3, "{:?}", a.lift_peaks);
+        assert!((a.lift_peaks[0][0] - 3.0 * st).abs() < 3e-3, "{:?}", a.lift_peaks);
+        assert!(is_harmonic_series(&a.lift_peaks, a.strouhal_spectral.unwrap()));
     }
 
     /// Two unrelated tones: the taller one is the frequency, whichever is lower.
@@ -333,6 +374,14 @@ mod tests {
         let a = analyse(&t, &cd, &cl, 60.0);
         assert!((a.strouhal_spectral.unwrap() - 0.102).abs() < 3e-3, "{:?}", a.strouhal_spectral);
         assert!(a.strouhal.is_some() && a.periods >= 5, "{a:?}");
+        // The five tones are listed, tallest first, and are no harmonic series.
+        let listed: Vec<f64> = a.lift_peaks.iter().map(|p| p[0]).collect();
+        assert_eq!(listed.len(), 5, "{:?}", a.lift_peaks);
+        for (p, f) in listed.iter().zip([0.102, 0.075, 0.14, 0.052, 0.195]) {
+            assert!((p - f).abs() < 3e-3, "{listed:?}");
+        }
+        assert_eq!(a.lift_peaks[0][1], 1.0);
+        assert!(!is_harmonic_series(&a.lift_peaks, a.strouhal_spectral.unwrap()));
     }
 
     #[test]

@@ -73,6 +73,10 @@ pub struct AnalysisOut {
     pub strouhal_spectral: Option<f64>,
     pub periods: usize,
     pub window: [f64; 2],
+    /// The lift spectrum's substantial peaks `[St, height / tallest]`, tallest first (absent in
+    /// reports written before it was added).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub lift_peaks: Vec<[f64; 2]>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -225,10 +229,26 @@ impl ValidationReport {
                 strouhal_spectral: a.strouhal_spectral,
                 periods: a.periods,
                 window: a.window,
+                lift_peaks: a.lift_peaks.clone(),
             },
             plots: vec!["forces.png".into(), "spectrum.png".into(), "vorticity.png".into()],
             manifest: manifest(threads, out.wall_time_s),
         }
+    }
+
+    /// A line for a lift that is no limit cycle: its spectrum's substantial peaks are not all
+    /// harmonics of the frequency measured, so a Strouhal number summarises a broadband wake.
+    pub fn broadband_note(&self) -> Option<String> {
+        let f = self.analysis.strouhal_spectral?;
+        let peaks = &self.analysis.lift_peaks;
+        if peaks.is_empty() || crate::validate::analysis::is_harmonic_series(peaks, f) {
+            return None;
+        }
+        let list: Vec<String> = peaks.iter().map(|p| format!("{:.3} ({:.2})", p[0], p[1])).collect();
+        Some(format!(
+            "broadband lift, not a limit cycle: spectral peaks at St {} (height / tallest); the Strouhal number counts the cycles of the tallest",
+            list.join(", ")
+        ))
     }
 
     /// Plain-text table: quantity, measured, reference, deviation, pass/fail.
@@ -297,6 +317,9 @@ impl ValidationReport {
         if let Some(m) = &self.message {
             s += &format!("  note: {m}\n");
         }
+        if let Some(line) = self.broadband_note() {
+            s += &format!("  note: {line}\n");
+        }
         s += &format!(
             "  {} of {} steps in {:.1} s ({:.0} MLUPS), {} whole periods averaged over t = [{:.1}, {:.1}]\n",
             self.parameters.steps_run,
@@ -357,4 +380,31 @@ pub fn write_plots(r: &ValidationReport, out: &RunOutput, dir: &Path) -> Result<
         &format!("{}: vorticity w L/U at t = {t_end:.1}", r.case),
     )?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A committed report (written before `lift_peaks` existed) still reads; with the peaks of a
+    /// broadband lift (square cylinder, Re 1000, characteristic inlet run) its table says so, and
+    /// with a harmonic series it does not.
+    #[test]
+    fn a_broadband_lift_is_named_in_the_table() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/validation/square_re1000.json");
+        let text = std::fs::read_to_string(path).unwrap();
+        let mut r: ValidationReport = serde_json::from_str(&text).unwrap();
+        assert!(r.analysis.lift_peaks.is_empty());
+        assert!(r.broadband_note().is_none());
+        r.analysis.strouhal_spectral = Some(0.0917);
+        r.analysis.lift_peaks = vec![[0.0917, 1.0], [0.0833, 0.93], [0.1, 0.51], [0.2, 0.49]];
+        let table = r.table();
+        assert!(
+            table.contains("note: broadband lift, not a limit cycle: spectral peaks at St 0.092 (1.00), 0.083 (0.93)"),
+            "{table}"
+        );
+        r.analysis.lift_peaks = vec![[0.0917, 1.0], [0.1834, 0.6], [0.2751, 0.3]];
+        assert!(r.broadband_note().is_none());
+        assert!(!r.table().contains("broadband"));
+    }
 }
