@@ -2,6 +2,9 @@
 //! between itself and the outlet leaves through a characteristic one; a uniform inflow is left
 //! alone; the fast kernel applies the inlet exactly as the slow oracle does.
 
+mod common;
+
+use common::acoustic_energy;
 use hgym_solvers::lbm::{D2q9, D2q9Config, Side, Sides};
 
 const U: f32 = 0.05;
@@ -20,18 +23,6 @@ fn duct(nx: usize, characteristic: Option<f64>) -> D2q9 {
     let mut cfg = D2q9Config::new(nx, ny, 0.52, sides);
     cfg.characteristic_inlet = characteristic;
     D2q9::new(cfg, Vec::new()).unwrap()
-}
-
-/// Mean squared density deviation over the duct.
-fn acoustic_energy(s: &D2q9) -> f64 {
-    let mut e = 0.0;
-    for y in 0..s.ny() {
-        for x in 0..s.nx() {
-            let (rho, _, _) = s.node(x, y);
-            e += ((rho - 1.0) as f64).powi(2);
-        }
-    }
-    e / (s.nx() * s.ny()) as f64
 }
 
 /// The uniform inflow plus a Gaussian density pulse (width 12 nodes) centred at `x0`.

@@ -2,8 +2,11 @@
 //! already at their target state alone, and the fast kernel applies them exactly like the slow
 //! oracle. And the force on an open body excludes the reference pressure.
 
+mod common;
+
 use std::sync::Arc;
 
+use common::acoustic_energy;
 use hgym_solvers::geometry::{Rectangle, Shape};
 use hgym_solvers::lbm::{D2q9, D2q9Config, Edge, Side, Sides, Sponge};
 
@@ -34,18 +37,6 @@ fn top_sponge(ny: usize) -> Sponge {
         rho: 1.0,
         u: [0.0, 0.0],
     }
-}
-
-/// Mean squared density deviation over the channel.
-fn acoustic_energy(s: &D2q9) -> f64 {
-    let mut e = 0.0;
-    for y in 0..s.ny() {
-        for x in 0..s.nx() {
-            let (rho, _, _) = s.node(x, y);
-            e += ((rho - 1.0) as f64).powi(2);
-        }
-    }
-    e / (s.nx() * s.ny()) as f64
 }
 
 /// The lowest vertical mode between the floor and the top: `rho = 1 + a cos(pi (y + 1/2) / ny)`.
