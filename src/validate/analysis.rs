@@ -39,8 +39,8 @@ pub struct Analysis {
     pub periods: usize,
     /// Time window the means are taken over `[t0, t1]`.
     pub window: [f64; 2],
-    /// The lift spectrum's substantial peaks (see [`lift_peaks`]): `[frequency, height relative
-    /// to the tallest]`, tallest first.
+    /// The lift spectrum's substantial peaks (at least a quarter of the tallest): `[frequency,
+    /// height relative to the tallest]`, tallest first, at most [`MAX_PEAKS`].
     pub lift_peaks: Vec<[f64; 2]>,
 }
 
@@ -97,7 +97,7 @@ fn substantial_peaks(freqs: &[f64], amps: &[f64]) -> Vec<(f64, f64)> {
     peaks
 }
 
-/// The most peaks [`lift_peaks`] lists.
+/// The most peaks a report lists.
 pub const MAX_PEAKS: usize = 8;
 
 /// Whether `f` is a whole multiple of `base` within 3 %.
@@ -110,8 +110,7 @@ fn multiple_of(f: f64, base: f64) -> bool {
 /// (at most [`MAX_PEAKS`]): what a reader needs to tell a limit cycle (the fundamental and its
 /// harmonics) from a broadband, chaotic wake (peaks at unrelated frequencies) without re-running
 /// the case.
-pub fn lift_peaks(freqs: &[f64], amps: &[f64]) -> Vec<[f64; 2]> {
-    let peaks = substantial_peaks(freqs, amps);
+fn lift_peaks(peaks: &[(f64, f64)]) -> Vec<[f64; 2]> {
     let top = peaks.first().map_or(1.0, |p| p.1);
     peaks.iter().take(MAX_PEAKS).map(|&(f, a)| [f, a / top]).collect()
 }
@@ -129,8 +128,7 @@ pub fn is_harmonic_series(peaks: &[[f64; 2]], fundamental: f64) -> bool {
 /// cylinder at Re 1000 with its lattice velocity halved has its tallest peak at 0.102 and
 /// substantial ones at 0.052 and 0.075; 0.052 is half of 0.102 but 0.075 is no multiple of it,
 /// and taking 0.052 smoothed the crossings away (no Strouhal number at all).
-fn spectral_fundamental(freqs: &[f64], amps: &[f64]) -> Option<f64> {
-    let peaks = substantial_peaks(freqs, amps);
+fn spectral_fundamental(peaks: &[(f64, f64)]) -> Option<f64> {
     let f_top = peaks.first()?.0;
     let mut lower: Vec<f64> = peaks.iter().map(|p| p.0).filter(|&f| f < f_top).collect();
     lower.sort_by(f64::total_cmp);
@@ -172,8 +170,10 @@ pub fn analyse(t: &[f64], cd: &[f64], cl: &[f64], t_start: f64) -> Analysis {
     let std = (cl.iter().map(|v| (v - m_cl).powi(2)).sum::<f64>() / n as f64).sqrt();
     let hyst = 0.1 * std;
     let (freqs, amps) = spectrum(t, cl);
-    let strouhal_spectral = if std > 1e-9 { spectral_fundamental(&freqs, &amps) } else { None };
-    let peaks = if std > 1e-9 { lift_peaks(&freqs, &amps) } else { vec![] };
+    // The spectrum's substantial peaks, found once: they give both the fundamental and the list.
+    let peaks = if std > 1e-9 { substantial_peaks(&freqs, &amps) } else { vec![] };
+    let strouhal_spectral = spectral_fundamental(&peaks);
+    let peaks = lift_peaks(&peaks);
     // Crossings are found on the lift low-passed by centred moving averages over a half and a
     // third of the fundamental period (see the module doc), so that harmonics and high-frequency
     // noise cannot add crossings; means and amplitudes use the raw signal.
