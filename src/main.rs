@@ -265,8 +265,12 @@ enum DataCommand {
 
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum CollisionArg {
+    /// Single-relaxation-time BGK.
     Bgk,
+    /// Regularised BGK (Latt & Chopard 2006), the default of every case and environment.
     Regularized,
+    /// Recursive regularised BGK (Malaspinas 2015; Coreixas et al. 2017).
+    Recursive,
 }
 
 /// Outcome of a command: 0 ok, 1 a check failed.
@@ -465,6 +469,7 @@ fn run_bench(json: bool, quick: bool, collision: CollisionArg) -> Result<Outcome
         collision: match collision {
             CollisionArg::Bgk => hgym_solvers::lbm::Collision::Bgk,
             CollisionArg::Regularized => hgym_solvers::lbm::Collision::Regularized,
+            CollisionArg::Recursive => hgym_solvers::lbm::Collision::Recursive,
         },
         ..LbmBenchOptions::default()
     };

@@ -549,6 +549,31 @@ fn run_writes_metrics_plots_and_manifest() {
 /// The Schäfer-Turek case at its coarse level (D = 20 cells) with a 2:1 patch around the
 /// cylinder: the drag moves towards the benchmark like the uniformly finer grid's, and the report
 /// records the patch.
+/// A case can choose the recursive-regularised operator: the Schäfer-Turek benchmark passes with
+/// it at the coarse level, and the report names it (and still matches the schema).
+#[test]
+fn a_case_with_the_recursive_operator_passes_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let plain = std::fs::read_to_string(repo().join("tests/cases/schaefer_turek_2d1.toml")).unwrap();
+    assert!(plain.contains("collision = \"regularized\""));
+    let body = plain
+        .replace("name = \"schaefer_turek_2d1\"", "name = \"st_recursive\"")
+        .replace("collision = \"regularized\"", "collision = \"recursive\"");
+    let case = write_case(dir.path(), "st_recursive", &body);
+    let report = validate_coarse(&case, &dir.path().join("out"));
+    schema_check(&report);
+    assert_eq!(report["parameters"]["collision"], "recursive");
+    println!("Schäfer-Turek 2D-1, recursive operator: C_D {:.4}", measured(&report, "mean_cd"));
+
+    // An unknown operator is refused naming the field and the choices.
+    let bad = body.replace("collision = \"recursive\"", "collision = \"cumulant\"");
+    let case = write_case(dir.path(), "st_bad", &bad);
+    let o = run_coarse(&case, &dir.path().join("bad"), false);
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("cumulant") && err.contains("recursive"), "{err}");
+}
+
 #[test]
 fn a_refined_case_runs_records_its_patch_and_improves_the_drag() {
     let dir = tempfile::tempdir().unwrap();

@@ -46,8 +46,10 @@ fn fast_kernel_matches_the_slow_oracle_bitwise() {
     for (collision, stream) in [
         (Collision::Bgk, false),
         (Collision::Regularized, false),
+        (Collision::Recursive, false),
         (Collision::Bgk, true),
         (Collision::Regularized, true),
+        (Collision::Recursive, true),
     ] {
         let mut fast = cylinder_case_with(collision, Some(stream));
         let mut slow = cylinder_case(collision);

@@ -285,9 +285,11 @@ pub struct FlowSpec {
     pub reynolds: f64,
     /// Lattice value of U.
     pub lattice_velocity: f64,
+    /// `"bgk"`, `"regularized"` (default) or `"recursive"` (recursive regularised: stable much
+    /// closer to tau = 1/2, see `hgym_solvers::lbm::collision`).
     #[serde(default)]
     pub collision: Collision,
-    /// Smagorinsky constant of the subgrid viscosity (regularised operator; 0 = none). Laminar
+    /// Smagorinsky constant of the subgrid viscosity (regularised operators; 0 = none). Laminar
     /// validation cases leave it at 0; under-resolved runs at Re >= 1000 need about 0.1.
     #[serde(default)]
     pub smagorinsky: f64,

@@ -16,6 +16,18 @@
 //!   start-up pulse, the echoes of vortices leaving the domain) die out within a few passes
 //!   instead of ringing in the forces, and the incompressible dynamics (div u = O(Ma^2)) are
 //!   unchanged.
+//! - **Recursive regularised** (Malaspinas, arXiv:1505.06900, 2015; Coreixas, Wissocq, Puigt,
+//!   Boussuge & Sagaut, PRE 96, 033306, 2017): the regularised operator plus every Hermite
+//!   polynomial D2Q9 can carry beyond second order, `H_xxy`, `H_xyy` and `H_xxyy`. Their equilibrium
+//!   coefficients are `rho ux^2 uy`, `rho ux uy^2`, `rho ux^2 uy^2`; their non-equilibrium
+//!   coefficients follow recursively from the (relaxed) second-order one,
+//!   `a1_xxy = 2 ux a1_xy + uy a1_xx`, `a1_xyy = 2 uy a1_xy + ux a1_yy`,
+//!   `a1_xxyy = ux^2 a1_yy + uy^2 a1_xx + 4 ux uy a1_xy`, and
+//!   `f_i += w_i [(H_xxy a_xxy + H_xyy a_xyy) / (2 c_s^6) + H_xxyy a_xxyy / (4 c_s^8)]`. The
+//!   extra terms are orthogonal to mass, momentum and stress, so the hydrodynamics are those of
+//!   the regularised operator; what changes is that the third- and fourth-order moments no longer
+//!   sit at the wrong (second-order-equilibrium) values, which is what limits the regularised
+//!   operator's stability as `tau -> 1/2`.
 //! - **Forcing** (Guo, Zheng & Shi, PRE 65, 2002): `u = (j + F/2) / rho`,
 //!   `S_i = (1 - omega/2) w_i [3 (c_i - u) + 9 (c_i.u) c_i] . F`, added after either operator; the
 //!   regularised operator keeps the first-order part `-F/2` of `f^neq` (relaxed by `1 - omega`),
@@ -25,7 +37,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::lattice::{CX, CY, Q, W};
+use super::lattice::{CS2, CX, CY, Q, W};
 
 /// Relaxation rate of the trace of the non-equilibrium stress in the regularised operator
 /// (bulk viscosity `(1/OMEGA_BULK - 1/2) / 3`).
@@ -40,7 +52,16 @@ pub enum Collision {
     /// Regularised BGK (Latt & Chopard 2006).
     #[default]
     Regularized,
+    /// Recursive regularised BGK (Malaspinas 2015; Coreixas et al. 2017).
+    Recursive,
 }
+
+/// Operator codes for the kernels' const generic `OP` (a `Collision` as a number).
+pub const OP_BGK: u8 = 0;
+/// See [`OP_BGK`].
+pub const OP_REG: u8 = 1;
+/// See [`OP_BGK`].
+pub const OP_RR: u8 = 2;
 
 impl Collision {
     /// Smallest `tau - 1/2` the operator is allowed to run with. Below it the scheme has no
@@ -49,7 +70,7 @@ impl Collision {
     pub fn min_tau_margin(self) -> f64 {
         match self {
             Collision::Bgk => 0.005,
-            Collision::Regularized => 2.0e-4,
+            Collision::Regularized | Collision::Recursive => 2.0e-4,
         }
     }
 
@@ -57,7 +78,14 @@ impl Collision {
         match self {
             Collision::Bgk => "bgk",
             Collision::Regularized => "regularized",
+            Collision::Recursive => "recursive",
         }
+    }
+
+    /// Whether the operator filters the non-equilibrium part through Hermite polynomials (and so
+    /// accepts the Smagorinsky model).
+    pub fn is_regularized(self) -> bool {
+        !matches!(self, Collision::Bgk)
     }
 }
 
@@ -85,10 +113,11 @@ pub fn equilibrium(drho: f32, ux: f32, uy: f32) -> [f32; Q] {
 
 /// One collision of the shifted populations `g` in place.
 ///
-/// `REG` selects the regularised operator, `FORCED` adds Guo forcing with `(fx, fy)`.
+/// `OP` selects the operator ([`OP_BGK`], [`OP_REG`], [`OP_RR`]), `FORCED` adds Guo forcing with
+/// `(fx, fy)`.
 #[inline(always)]
-pub fn collide<const REG: bool, const FORCED: bool>(g: &mut [f32; Q], omega: f32, fx: f32, fy: f32) {
-    collide_les::<REG, FORCED, false>(
+pub fn collide<const OP: u8, const FORCED: bool>(g: &mut [f32; Q], omega: f32, fx: f32, fy: f32) {
+    collide_les::<OP, FORCED, false>(
         g,
         Relax {
             omega,
@@ -119,14 +148,14 @@ impl Relax {
     }
 }
 
-/// [`collide`] with an optional Smagorinsky subgrid viscosity (`LES`, regularised operator only):
+/// [`collide`] with an optional Smagorinsky subgrid viscosity (`LES`, regularised operators only):
 /// `nu_t = (C_s dx)^2 |S|`, with the strain rate taken from the non-equilibrium stress, so the
 /// local relaxation time solves `tau^2 - tau0 tau - C_s^2 |Pi^neq| / (sqrt(2) rho c_s^4) = 0`:
 /// `tau = (tau0 + sqrt(tau0^2 + 18 sqrt(2) C_s^2 |Pi^neq| / rho)) / 2` (Hou, Sterling, Chen &
 /// Doolen, Fields Inst. Commun. 6, 1996; Malaspinas & Sagaut, J. Fluid Mech. 700, 2012). It
 /// vanishes in resolved laminar flow and keeps under-resolved flows at Re 1000-3900 stable.
 #[inline(always)]
-pub fn collide_les<const REG: bool, const FORCED: bool, const LES: bool>(g: &mut [f32; Q], relax: Relax, fx: f32, fy: f32) {
+pub fn collide_les<const OP: u8, const FORCED: bool, const LES: bool>(g: &mut [f32; Q], relax: Relax, fx: f32, fy: f32) {
     let omega = relax.omega;
     let (drho, jx, jy) = moments(g);
     let rho = 1.0 + drho;
@@ -137,7 +166,7 @@ pub fn collide_les<const REG: bool, const FORCED: bool, const LES: bool>(g: &mut
         (jx * inv_rho, jy * inv_rho)
     };
     let geq = equilibrium(drho, ux, uy);
-    if REG {
+    if OP != OP_BGK {
         let mut n = [0.0f32; Q];
         for i in 0..Q {
             n[i] = g[i] - geq[i];
@@ -172,6 +201,9 @@ pub fn collide_les<const REG: bool, const FORCED: bool, const LES: bool>(g: &mut
         g[7] = geq[7] + r57;
         g[6] = geq[6] + r68;
         g[8] = geq[8] + r68;
+        if OP == OP_RR {
+            add_third_and_fourth_order(g, rho, ux, uy, [qxx, qyy, qxy]);
+        }
         if FORCED {
             // The non-equilibrium part also has a first-order Hermite component, -F/2 (the
             // equilibrium carries the half-force-shifted momentum); BGK relaxes it by (1 - omega),
@@ -202,6 +234,35 @@ pub fn collide_les<const REG: bool, const FORCED: bool, const LES: bool>(g: &mut
             g[i] += pre * W[i] * (3.0 * (cf - uf) + 9.0 * cu * cf);
         }
     }
+}
+
+/// The recursive-regularised operator's terms beyond second order: equilibrium plus relaxed
+/// non-equilibrium coefficients of `H_xxy`, `H_xyy` and `H_xxyy` (module docs), from the density,
+/// the velocity and the relaxed second-order non-equilibrium coefficient `q = [xx, yy, xy]`.
+/// With `c_s^2 = 1/3`: `1 / (2 c_s^6) = 27/2`, `1 / (4 c_s^8) = 81/4`.
+#[inline(always)]
+pub fn add_third_and_fourth_order(g: &mut [f32; Q], rho: f32, ux: f32, uy: f32, q: [f32; 3]) {
+    let [qxx, qyy, qxy] = q;
+    let (uxx, uyy, uxy) = (ux * ux, uy * uy, ux * uy);
+    let a_xxy = rho * uxx * uy + 2.0 * ux * qxy + uy * qxx;
+    let a_xyy = rho * uyy * ux + 2.0 * uy * qxy + ux * qyy;
+    let a_xxyy = rho * uxx * uyy + uxx * qyy + uyy * qxx + 4.0 * uxy * qxy;
+    for i in 0..Q {
+        let (cx, cy) = (CX[i] as f32, CY[i] as f32);
+        let h_xxy = (cx * cx - CS2) * cy;
+        let h_xyy = (cy * cy - CS2) * cx;
+        let h_xxyy = (cx * cx - CS2) * (cy * cy - CS2);
+        g[i] += W[i] * (13.5 * (h_xxy * a_xxy + h_xyy * a_xyy) + 20.25 * h_xxyy * a_xxyy);
+    }
+}
+
+/// The shifted equilibrium of the recursive-regularised operator: [`equilibrium`] plus the
+/// third- and fourth-order Hermite terms D2Q9 carries (`rho ux^2 uy`, `rho ux uy^2`,
+/// `rho ux^2 uy^2`). It is the operator's fixed point.
+pub fn equilibrium_extended(drho: f32, ux: f32, uy: f32) -> [f32; Q] {
+    let mut e = equilibrium(drho, ux, uy);
+    add_third_and_fourth_order(&mut e, 1.0 + drho, ux, uy, [0.0; 3]);
+    e
 }
 
 /// Density deviation, velocity (no forcing) and second-order Hermite projection of the
@@ -259,11 +320,11 @@ mod tests {
         g
     }
 
-    fn check_conservation<const REG: bool>() {
+    fn check_conservation<const OP: u8>() {
         let g0 = sample();
         let (r0, jx0, jy0) = moments(&g0);
         let mut g = g0;
-        collide::<REG, false>(&mut g, 1.7, 0.0, 0.0);
+        collide::<OP, false>(&mut g, 1.7, 0.0, 0.0);
         let (r1, jx1, jy1) = moments(&g);
         assert!((r1 - r0).abs() < 1e-7, "mass {r0} -> {r1}");
         assert!((jx1 - jx0).abs() < 1e-7 && (jy1 - jy0).abs() < 1e-7);
@@ -271,8 +332,9 @@ mod tests {
 
     #[test]
     fn collisions_conserve_mass_and_momentum() {
-        check_conservation::<false>();
-        check_conservation::<true>();
+        check_conservation::<OP_BGK>();
+        check_conservation::<OP_REG>();
+        check_conservation::<OP_RR>();
     }
 
     #[test]
@@ -287,7 +349,7 @@ mod tests {
         // After a regularised collision the stress is (1 - omega) times the deviatoric part
         // (the trace is relaxed with OMEGA_BULK = 1), so rebuilding from it is the identity.
         let mut c = sample();
-        collide::<true, false>(&mut c, 1.7, 0.0, 0.0);
+        collide::<OP_REG, false>(&mut c, 1.7, 0.0, 0.0);
         let (drho, ux, uy, p) = hermite_stress(&c);
         let back = hermite_populations(drho, ux, uy, p);
         for i in 0..Q {
@@ -301,9 +363,9 @@ mod tests {
         for reg in [false, true] {
             let mut g = e;
             if reg {
-                collide::<true, false>(&mut g, 1.9, 0.0, 0.0);
+                collide::<OP_REG, false>(&mut g, 1.9, 0.0, 0.0);
             } else {
-                collide::<false, false>(&mut g, 1.9, 0.0, 0.0);
+                collide::<OP_BGK, false>(&mut g, 1.9, 0.0, 0.0);
             }
             for i in 0..Q {
                 assert!((g[i] - e[i]).abs() < 1e-8);
@@ -312,17 +374,57 @@ mod tests {
     }
 
     #[test]
+    fn the_extended_equilibrium_is_the_recursive_operators_fixed_point() {
+        let e = equilibrium_extended(0.02, 0.04, 0.01);
+        let mut g = e;
+        collide::<OP_RR, false>(&mut g, 1.9, 0.0, 0.0);
+        for i in 0..Q {
+            assert!((g[i] - e[i]).abs() < 1e-8, "direction {i}: {} vs {}", g[i], e[i]);
+        }
+        // and the second-order equilibrium is not: D2Q9 carries rho ux^2 uy etc.
+        let e2 = equilibrium(0.02, 0.04, 0.01);
+        assert!((0..Q).any(|i| (e[i] - e2[i]).abs() > 1e-7));
+    }
+
+    /// After a recursive collision the third-order Hermite moment is
+    /// `a_xxy = rho ux^2 uy + 2 ux q_xy + uy q_xx` with `q = (1 - omega) Pi^neq` the relaxed stress
+    /// (a traceless stress, so the bulk rate plays no part).
+    #[test]
+    fn recursive_third_order_moments_follow_the_recursion() {
+        let (drho, ux, uy) = (0.01f32, 0.05f32, -0.03f32);
+        // A purely deviatoric, traceless non-equilibrium stress, relaxed with omega alone.
+        let q = [1.0e-3, -1.0e-3, 6.0e-4];
+        let mut g = hermite_populations(drho, ux, uy, q);
+        let omega = 1.6f32;
+        collide::<OP_RR, false>(&mut g, omega, 0.0, 0.0);
+        let rho = 1.0 + drho;
+        let k = 1.0 - omega;
+        let third = |g: &[f32; Q], a: [i32; 3]| -> f64 {
+            (0..Q)
+                .map(|i| {
+                    let c = [CX[i], CY[i]];
+                    (g[i] as f64) * (c[a[0] as usize] * c[a[1] as usize] * c[a[2] as usize]) as f64
+                })
+                .sum()
+        };
+        // Hermite moment a_xxy = sum (cx^2 - c_s^2) cy f_i (the shifted weights' part is zero).
+        let m_xxy = third(&g, [0, 0, 1]) - (CS2 as f64) * (0..Q).map(|i| g[i] as f64 * CY[i] as f64).sum::<f64>();
+        let expect = rho * ux * ux * uy + k * (2.0 * ux * q[2] + uy * q[0]);
+        assert!((m_xxy - expect as f64).abs() < 1e-7, "a_xxy {m_xxy} vs {expect}");
+    }
+
+    #[test]
     fn guo_forcing_adds_the_force_to_the_momentum() {
-        for reg in [false, true] {
+        for op in [OP_BGK, OP_REG, OP_RR] {
             let mut g = sample();
             let (_, jx0, jy0) = moments(&g);
-            if reg {
-                collide::<true, true>(&mut g, 1.2, 1e-4, -2e-4);
-            } else {
-                collide::<false, true>(&mut g, 1.2, 1e-4, -2e-4);
+            match op {
+                OP_BGK => collide::<OP_BGK, true>(&mut g, 1.2, 1e-4, -2e-4),
+                OP_REG => collide::<OP_REG, true>(&mut g, 1.2, 1e-4, -2e-4),
+                _ => collide::<OP_RR, true>(&mut g, 1.2, 1e-4, -2e-4),
             }
             let (_, jx1, jy1) = moments(&g);
-            assert!((jx1 - jx0 - 1e-4).abs() < 1e-8, "reg {reg}: {}", jx1 - jx0);
+            assert!((jx1 - jx0 - 1e-4).abs() < 1e-8, "operator {op}: {}", jx1 - jx0);
             assert!((jy1 - jy0 + 2e-4).abs() < 1e-8);
         }
     }

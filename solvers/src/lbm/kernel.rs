@@ -7,7 +7,7 @@
 //! general path, which reads in order: load, boundaries, moments, collide, store.
 
 use super::boundary::{bouzidi, side_value, InletReference};
-use super::collision::{collide_les, Collision, Relax};
+use super::collision::{collide_les, Collision, Relax, OP_BGK, OP_REG, OP_RR};
 use super::domain::Sides;
 use super::lattice::{CX, CY, Q};
 
@@ -109,7 +109,7 @@ fn nt_rows_possible(row: &[f32], nx: usize) -> bool {
 
 /// Interior of a row, ordinary stores: `x = 1 .. nx-2`, `s[i][x - 1]` streams into node `x`.
 #[inline(always)]
-fn bulk_row_plain<const REG: bool, const FORCED: bool, const LES: bool>(c: &KernelCtx, s: [&[f32]; Q], row: &mut [f32]) {
+fn bulk_row_plain<const OP: u8, const FORCED: bool, const LES: bool>(c: &KernelCtx, s: [&[f32]; Q], row: &mut [f32]) {
     let nx = c.nx;
     let n = nx - 2;
     let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = s;
@@ -145,7 +145,7 @@ fn bulk_row_plain<const REG: bool, const FORCED: bool, const LES: bool>(c: &Kern
     );
     for x in 0..n {
         let mut g = [s0[x], s1[x], s2[x], s3[x], s4[x], s5[x], s6[x], s7[x], s8[x]];
-        collide_les::<REG, FORCED, LES>(&mut g, c.relax, c.fx, c.fy);
+        collide_les::<OP, FORCED, LES>(&mut g, c.relax, c.fx, c.fy);
         d0[x] = g[0];
         d1[x] = g[1];
         d2[x] = g[2];
@@ -163,7 +163,7 @@ fn bulk_row_plain<const REG: bool, const FORCED: bool, const LES: bool>(c: &Kern
 /// 72 bytes of memory traffic instead of 108. Values are identical to [`bulk_row_plain`]; the
 /// edge nodes `x = 0, nx-1` are written as zero here and overwritten by the general path.
 #[inline(always)]
-fn bulk_row_streamed<const REG: bool, const FORCED: bool, const LES: bool>(c: &KernelCtx, s: [&[f32]; Q], row: &mut [f32]) {
+fn bulk_row_streamed<const OP: u8, const FORCED: bool, const LES: bool>(c: &KernelCtx, s: [&[f32]; Q], row: &mut [f32]) {
     const CHUNK: usize = 256;
     let nx = c.nx;
     let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = s;
@@ -201,7 +201,7 @@ fn bulk_row_streamed<const REG: bool, const FORCED: bool, const LES: bool>(c: &K
         );
         for k in 0..m {
             let mut g = [t0[k], t1[k], t2[k], t3[k], t4[k], t5[k], t6[k], t7[k], t8[k]];
-            collide_les::<REG, FORCED, LES>(&mut g, c.relax, c.fx, c.fy);
+            collide_les::<OP, FORCED, LES>(&mut g, c.relax, c.fx, c.fy);
             b0[k] = g[0];
             b1[k] = g[1];
             b2[k] = g[2];
@@ -269,29 +269,37 @@ fn store_fence() {
 pub(crate) type RowFn = fn(&KernelCtx, &[f32], &mut [f32], usize);
 
 /// The row function compiled for one choice of operator, forcing and subgrid model (the
-/// subgrid model exists only for the regularised operator); `reference` picks the slow oracle.
+/// subgrid model exists only for the regularised operators); `reference` picks the slow oracle.
 pub(crate) fn row_fn(collision: Collision, forced: bool, les: bool, reference: bool) -> RowFn {
     macro_rules! pick {
-        ($reg:literal, $forced:literal, $les:literal) => {
+        ($op:expr, $forced:literal, $les:literal) => {
             if reference {
-                row_reference::<$reg, $forced, $les>
+                row_reference::<{ $op }, $forced, $les>
             } else {
-                row_kernel::<$reg, $forced, $les>
+                row_kernel::<{ $op }, $forced, $les>
             }
         };
     }
-    match (collision, forced, les) {
-        (Collision::Bgk, false, _) => pick!(false, false, false),
-        (Collision::Bgk, true, _) => pick!(false, true, false),
-        (Collision::Regularized, false, false) => pick!(true, false, false),
-        (Collision::Regularized, true, false) => pick!(true, true, false),
-        (Collision::Regularized, false, true) => pick!(true, false, true),
-        (Collision::Regularized, true, true) => pick!(true, true, true),
+    macro_rules! regularized {
+        ($op:expr) => {
+            match (forced, les) {
+                (false, false) => pick!($op, false, false),
+                (true, false) => pick!($op, true, false),
+                (false, true) => pick!($op, false, true),
+                (true, true) => pick!($op, true, true),
+            }
+        };
+    }
+    match (collision, forced) {
+        (Collision::Bgk, false) => pick!(OP_BGK, false, false),
+        (Collision::Bgk, true) => pick!(OP_BGK, true, false),
+        (Collision::Regularized, _) => regularized!(OP_REG),
+        (Collision::Recursive, _) => regularized!(OP_RR),
     }
 }
 
 /// One row of the step: vectorised interior, then the special nodes.
-fn row_kernel<const REG: bool, const FORCED: bool, const LES: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
+fn row_kernel<const OP: u8, const FORCED: bool, const LES: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
     let nx = c.nx;
     let bulk = c.periodic_y || (y > 0 && y + 1 < c.ny);
     if bulk {
@@ -310,19 +318,19 @@ fn row_kernel<const REG: bool, const FORCED: bool, const LES: bool>(c: &KernelCt
             &s8[..n],
         );
         if c.stream_stores && nt_rows_possible(row, nx) {
-            bulk_row_streamed::<REG, FORCED, LES>(c, [s0, s1, s2, s3, s4, s5, s6, s7, s8], row);
+            bulk_row_streamed::<OP, FORCED, LES>(c, [s0, s1, s2, s3, s4, s5, s6, s7, s8], row);
         } else {
-            bulk_row_plain::<REG, FORCED, LES>(c, [s0, s1, s2, s3, s4, s5, s6, s7, s8], row);
+            bulk_row_plain::<OP, FORCED, LES>(c, [s0, s1, s2, s3, s4, s5, s6, s7, s8], row);
         }
     }
     let specials = &c.specials[c.row_start[y] as usize..c.row_start[y + 1] as usize];
     for sp in specials {
-        general_node::<REG, FORCED, LES>(c, src, row, sp.x as usize, y, sp);
+        general_node::<OP, FORCED, LES>(c, src, row, sp.x as usize, y, sp);
     }
 }
 
 /// The same row, every node through the general path (the slow oracle of the tests).
-fn row_reference<const REG: bool, const FORCED: bool, const LES: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
+fn row_reference<const OP: u8, const FORCED: bool, const LES: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
     let specials = &c.specials[c.row_start[y] as usize..c.row_start[y + 1] as usize];
     for x in 0..c.nx {
         let plain = Special {
@@ -332,13 +340,13 @@ fn row_reference<const REG: bool, const FORCED: bool, const LES: bool>(c: &Kerne
             link_end: 0,
         };
         let sp = specials.iter().find(|s| s.x as usize == x).unwrap_or(&plain);
-        general_node::<REG, FORCED, LES>(c, src, row, x, y, sp);
+        general_node::<OP, FORCED, LES>(c, src, row, x, y, sp);
     }
 }
 
 /// The general path for one node: load with boundaries, collide, store.
 #[inline]
-fn general_node<const REG: bool, const FORCED: bool, const LES: bool>(
+fn general_node<const OP: u8, const FORCED: bool, const LES: bool>(
     c: &KernelCtx,
     src: &[f32],
     row: &mut [f32],
@@ -371,7 +379,7 @@ fn general_node<const REG: bool, const FORCED: bool, const LES: bool>(
             g[k] = side_value(c, src, x, y, k);
         }
     }
-    collide_les::<REG, FORCED, LES>(&mut g, c.relax, c.fx, c.fy);
+    collide_les::<OP, FORCED, LES>(&mut g, c.relax, c.fx, c.fy);
     for i in 0..Q {
         row[i * nx + x] = g[i];
     }

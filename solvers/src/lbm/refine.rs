@@ -509,7 +509,7 @@ fn interp(line: &[Moments], i: usize) -> Moments {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lbm::collision::{collide_les, Relax};
+    use crate::lbm::collision::{collide_les, Relax, OP_REG};
 
     /// A node of the simple shear flow `u = (gamma y, 0)` after a Smagorinsky collision with
     /// `tau0`: before it, equilibrium plus the Chapman-Enskog stress `Pi_xy = -2 rho c_s^2 tau S_xy`
@@ -518,7 +518,7 @@ mod tests {
         let a = (18.0 * 2f64.sqrt() * smagorinsky * smagorinsky / 6.0) as f32;
         let tau = tau0 as f32 + a * gamma / 2f32.sqrt();
         let mut g = hermite_populations(0.0, 0.02, 0.0, [0.0, 0.0, -tau * gamma / 3.0]);
-        collide_les::<true, false, true>(&mut g, Relax::new(tau0, smagorinsky), 0.0, 0.0);
+        collide_les::<OP_REG, false, true>(&mut g, Relax::new(tau0, smagorinsky), 0.0, 0.0);
         g
     }
 

@@ -204,7 +204,7 @@ impl D2q9 {
         if cfg.smagorinsky > 0.0 && cfg.collision == Collision::Bgk {
             return Err(config_error(
                 "smagorinsky",
-                "the subgrid model is built into the regularised operator; use collision = regularized",
+                "the subgrid model is built into the regularised operators; use collision = regularized or recursive",
             ));
         }
         let s = &cfg.sides;
