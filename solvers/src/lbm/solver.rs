@@ -201,7 +201,7 @@ impl D2q9 {
                 format!("C_s = {} must be in [0, 1] (0.1-0.17 is usual)", cfg.smagorinsky),
             ));
         }
-        if cfg.smagorinsky > 0.0 && cfg.collision == Collision::Bgk {
+        if cfg.smagorinsky > 0.0 && !cfg.collision.is_regularized() {
             return Err(config_error(
                 "smagorinsky",
                 "the subgrid model is built into the regularised operators; use collision = regularized or recursive",
