@@ -5,10 +5,9 @@
 
 use hgym_solvers::lbm::{Collision, D2q9, D2q9Config, Side, Sides};
 
-/// Doubly periodic shear layer on an `n x n` grid: `u = U tanh(80 (y/n - 1/4))` below the middle,
-/// `U tanh(80 (3/4 - y/n))` above, `v = 0.05 U sin(2 pi (x/n + 1/4))`. Runs `convective` times
-/// `n / U` and returns the step at which the solver reported divergence, if it did.
-fn shear_layer(n: usize, u0: f64, tau: f64, collision: Collision, convective: f64) -> Option<u64> {
+/// A doubly periodic `n x n` grid with relaxation time `tau` and the given operator (divergence
+/// checked every 20 steps).
+fn periodic(n: usize, tau: f64, collision: Collision) -> D2q9 {
     let sides = Sides {
         west: Side::Periodic,
         east: Side::Periodic,
@@ -18,7 +17,14 @@ fn shear_layer(n: usize, u0: f64, tau: f64, collision: Collision, convective: f6
     let mut cfg = D2q9Config::new(n, n, tau, sides);
     cfg.collision = collision;
     cfg.check_interval = 20;
-    let mut s = D2q9::new(cfg, vec![]).expect("valid configuration");
+    D2q9::new(cfg, vec![]).expect("valid configuration")
+}
+
+/// Doubly periodic shear layer on an `n x n` grid: `u = U tanh(80 (y/n - 1/4))` below the middle,
+/// `U tanh(80 (3/4 - y/n))` above, `v = 0.05 U sin(2 pi (x/n + 1/4))`. Runs `convective` times
+/// `n / U` and returns the step at which the solver reported divergence, if it did.
+fn shear_layer(n: usize, u0: f64, tau: f64, collision: Collision, convective: f64) -> Option<u64> {
+    let mut s = periodic(n, tau, collision);
     let l = n as f64;
     s.init_with(|x, y| {
         let (xs, ys) = (x / l, y / l);
@@ -64,15 +70,7 @@ fn recursive_and_regularised_agree_on_a_resolved_shear_layer() {
     let n = 64;
     let (u0, tau) = (0.05, 0.55);
     let run = |collision: Collision| {
-        let sides = Sides {
-            west: Side::Periodic,
-            east: Side::Periodic,
-            south: Side::Periodic,
-            north: Side::Periodic,
-        };
-        let mut cfg = D2q9Config::new(n, n, tau, sides);
-        cfg.collision = collision;
-        let mut s = D2q9::new(cfg, vec![]).expect("valid configuration");
+        let mut s = periodic(n, tau, collision);
         let l = n as f64;
         s.init_with(|x, y| {
             let (xs, ys) = (x / l, y / l);
