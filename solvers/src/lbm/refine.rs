@@ -26,7 +26,9 @@
 //! Smagorinsky model when it is on ([`StressMap`]). That is singular where a relaxation time is 1
 //! (the post-collision stress vanishes there), so such set-ups are refused; the flows that need
 //! refinement run at `tau` close to 1/2. BGK runs too: the interface keeps only the Hermite part
-//! of its non-equilibrium populations.
+//! of its non-equilibrium populations. With the recursive-regularised operator the rebuilt
+//! populations also get the third- and fourth-order terms that operator's collision writes,
+//! computed from the converted stress, so they are what a collision on that grid would produce.
 //!
 //! Bodies live on the finest grid (forces come from there); the coarser grids mark them solid
 //! too, but their nodes near them are overwritten each step. Sponges and domain edges stay on the coarse
@@ -35,7 +37,7 @@
 
 use std::sync::Arc;
 
-use super::collision::{hermite_populations, hermite_stress};
+use super::collision::{add_third_and_fourth_order, hermite_populations, hermite_stress, Collision};
 use super::domain::{Edge, Grid, Sides};
 use super::error::LbmError;
 use super::lattice::Q;
@@ -63,6 +65,10 @@ struct Coupling {
     patch: Patch,
     /// Stress conversion between the two grids' post-collision states.
     convert: StressMap,
+    /// Whether the grids run the recursive-regularised operator, whose post-collision
+    /// populations also carry third- and fourth-order Hermite terms (rebuilt from the same
+    /// moments, see [`rebuild`]).
+    recursive: bool,
     /// Grid `l`'s moments on the patch's edge lines (south, north: along x; west, east: along
     /// y) at the start (`old`) and the end (`new`) of grid `l`'s current step.
     old: [Vec<Moments>; 4],
@@ -207,6 +213,7 @@ impl Refined {
                 Coupling {
                     patch: *p,
                     convert: StressMap::new(tau_c, tau_f, coarse.config().smagorinsky),
+                    recursive: coarse.config().collision == Collision::Recursive,
                     old: lines.map(|n| vec![[0.0; 6]; n]),
                     new: lines.map(|n| vec![[0.0; 6]; n]),
                 }
@@ -365,7 +372,7 @@ fn write_ring(fine: &mut D2q9, c: &Coupling, theta: f32) {
         let b = interp(&c.new[line], i);
         let m: Moments = std::array::from_fn(|k| (1.0 - theta) * a[k] + theta * b[k]);
         let q = c.convert.to_fine(1.0 + m[0], [m[3], m[4], m[5]]);
-        hermite_populations(m[0], m[1], m[2], q)
+        rebuild(m[0], m[1], m[2], q, c.recursive)
     };
     for i in 0..fx {
         fine.set_node_populations(i, 0, &at(0, i));
@@ -386,7 +393,7 @@ const RESTRICT_CHUNK: usize = 64;
 fn restrict(coarse: &mut D2q9, fine: &D2q9, c: &Coupling) {
     let [x0, x1] = c.patch.x;
     let [y0, y1] = c.patch.y;
-    let convert = c.convert;
+    let (convert, recursive) = (c.convert, c.recursive);
     let (nc, nf) = (coarse.nx(), fine.nx());
     coarse.rewrite_rows(y0 + 1..y1, |y, solid, row| {
         let (fine_solid, fine_row) = fine.row(2 * (y - y0));
@@ -404,7 +411,7 @@ fn restrict(coarse: &mut D2q9, fine: &D2q9, c: &Coupling) {
             for k in 0..m {
                 let p = [g0[k], g1[k], g2[k], g3[k], g4[k], g5[k], g6[k], g7[k], g8[k]];
                 let (d, ux, uy, q) = hermite_stress(&p);
-                let out = hermite_populations(d, ux, uy, convert.to_coarse(1.0 + d, q));
+                let out = rebuild(d, ux, uy, convert.to_coarse(1.0 + d, q), recursive);
                 (g0[k], g1[k], g2[k], g3[k], g4[k]) = (out[0], out[1], out[2], out[3], out[4]);
                 (g5[k], g6[k], g7[k], g8[k]) = (out[5], out[6], out[7], out[8]);
             }
@@ -487,6 +494,18 @@ impl StressMap {
         let k = 2.0 * (tau_c - 1.0) / (tau_f - 1.0);
         q.map(|v| k * v)
     }
+}
+
+/// Post-collision populations from density deviation, velocity and post-collision stress `q`:
+/// the regularised form ([`hermite_populations`]), plus, for the recursive operator, the third-
+/// and fourth-order terms its collision writes ([`add_third_and_fourth_order`]).
+#[inline(always)]
+fn rebuild(drho: f32, ux: f32, uy: f32, q: [f32; 3], recursive: bool) -> [f32; Q] {
+    let mut g = hermite_populations(drho, ux, uy, q);
+    if recursive {
+        add_third_and_fourth_order(&mut g, 1.0 + drho, ux, uy, q);
+    }
+    g
 }
 
 /// Moments at fine index `i` along a coarse line (`i / 2` in coarse nodes): the node itself at
