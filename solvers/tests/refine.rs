@@ -100,19 +100,27 @@ fn a_taylor_green_vortex_decays_through_the_interface() {
     assert!(e_fine < e_uniform, "fine patch: {e_fine} vs uniform coarse {e_uniform}");
     assert!(drift.abs() < 1e-5, "relative mass drift {drift}");
 
+    // The same vortex on the uniform grid and with the patch, for one configuration: the
+    // Taylor-Green errors of the uniform grid and of the refined coarse and fine grids.
+    let with_patch = |cfg: D2q9Config| -> [f64; 3] {
+        let mut uniform = D2q9::new(cfg.clone(), vec![]).unwrap();
+        uniform.init_with(|x, y| taylor_green(n, u0, nu, 0.0, x, y));
+        uniform.advance(steps).unwrap();
+        let mut r = Refined::new(cfg, &[patch], vec![]).unwrap();
+        r.init_with(|x, y| taylor_green(n, u0, nu, 0.0, x, y));
+        r.advance(steps).unwrap();
+        [
+            tg_error(&uniform, [0.0, 0.0], 1.0, n, u0, nu, t),
+            tg_error(r.coarse(), [0.0, 0.0], 1.0, n, u0, nu, t),
+            tg_error(r.fine(), [10.0, 14.0], 0.5, n, u0, nu, t),
+        ]
+    };
+
     // With the Smagorinsky model on every level (the coupling then converts the stress through
     // the local relaxation time): the patch still costs the coarse grid little.
     let mut les = periodic(n, tau);
     les.smagorinsky = 0.1;
-    let mut uniform = D2q9::new(les.clone(), vec![]).unwrap();
-    uniform.init_with(|x, y| taylor_green(n, u0, nu, 0.0, x, y));
-    uniform.advance(steps).unwrap();
-    let e_uniform_les = tg_error(&uniform, [0.0, 0.0], 1.0, n, u0, nu, t);
-    let mut r = Refined::new(les, &[patch], vec![]).unwrap();
-    r.init_with(|x, y| taylor_green(n, u0, nu, 0.0, x, y));
-    r.advance(steps).unwrap();
-    let e_coarse_les = tg_error(r.coarse(), [0.0, 0.0], 1.0, n, u0, nu, t);
-    let e_fine_les = tg_error(r.fine(), [10.0, 14.0], 0.5, n, u0, nu, t);
+    let [e_uniform_les, e_coarse_les, e_fine_les] = with_patch(les);
     println!("  Smagorinsky C_s = 0.1: uniform {e_uniform_les:.3e}; refined coarse {e_coarse_les:.3e}, fine {e_fine_les:.3e}");
     assert!(
         e_coarse_les < 1.3 * e_uniform_les && e_fine_les < e_uniform_les,
@@ -125,15 +133,7 @@ fn a_taylor_green_vortex_decays_through_the_interface() {
     // fine-patch error of 2.969e-3, worse than the uniform coarse grid.
     let mut rr = periodic(n, tau);
     rr.collision = Collision::Recursive;
-    let mut uniform = D2q9::new(rr.clone(), vec![]).unwrap();
-    uniform.init_with(|x, y| taylor_green(n, u0, nu, 0.0, x, y));
-    uniform.advance(steps).unwrap();
-    let e_uniform_rr = tg_error(&uniform, [0.0, 0.0], 1.0, n, u0, nu, t);
-    let mut r = Refined::new(rr, &[patch], vec![]).unwrap();
-    r.init_with(|x, y| taylor_green(n, u0, nu, 0.0, x, y));
-    r.advance(steps).unwrap();
-    let e_coarse_rr = tg_error(r.coarse(), [0.0, 0.0], 1.0, n, u0, nu, t);
-    let e_fine_rr = tg_error(r.fine(), [10.0, 14.0], 0.5, n, u0, nu, t);
+    let [e_uniform_rr, e_coarse_rr, e_fine_rr] = with_patch(rr);
     println!("  recursive operator: uniform {e_uniform_rr:.3e}; refined coarse {e_coarse_rr:.3e}, fine {e_fine_rr:.3e}");
     assert!(
         e_coarse_rr < 1.3 * e_uniform_rr && e_fine_rr < e_uniform_rr,
