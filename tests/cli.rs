@@ -181,6 +181,16 @@ fn run_coarse(case: &Path, out: &Path, json: bool) -> std::process::Output {
     hgym(&args)
 }
 
+/// Writes `body` as case `name` in `dir` and runs it at the coarse level: it must be refused
+/// before anything runs (exit 2). Returns the error output.
+fn refused(dir: &Path, name: &str, body: &str) -> String {
+    let case = write_case(dir, name, body);
+    let o = run_coarse(&case, &dir.join(format!("{name}_out")), false);
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+    err
+}
+
 /// Runs one case file at the coarse level into `out`; it must pass. Returns its JSON report.
 fn validate_coarse(case: &Path, out: &Path) -> serde_json::Value {
     let o = run_coarse(case, out, true);
@@ -215,11 +225,7 @@ fn bad_absorbing_layers_are_refused_naming_the_problem() {
         ("deep", sponges(&["west"], 19.6), "reaches a body"),
         ("seam", sponges(&["north"], 2.0), "periodic"),
     ] {
-        let case = format!("{}\n{layers}", small_case(&[]));
-        let p = write_case(dir.path(), name, &case);
-        let o = run_coarse(&p, dir.path(), false);
-        assert_eq!(o.status.code(), Some(2), "{name}");
-        let (_, err) = text(&o);
+        let err = refused(dir.path(), name, &format!("{}\n{layers}", small_case(&[])));
         assert!(err.contains(expect), "{name}: {err}");
     }
 }
@@ -274,10 +280,7 @@ fn absorbing_layers_remove_the_acoustic_ringing_of_the_start() {
 fn a_negative_characteristic_time_is_refused_naming_the_field() {
     let dir = tempfile::tempdir().unwrap();
     let case = small_case(&[("profile = \"uniform\"\n", "profile = \"uniform\"\ncharacteristic_time = -1.0\n")]);
-    let p = write_case(dir.path(), "negative", &case);
-    let o = run_coarse(&p, dir.path(), false);
-    assert_eq!(o.status.code(), Some(2));
-    let (_, err) = text(&o);
+    let err = refused(dir.path(), "negative", &case);
     assert!(err.contains("inlet.characteristic_time"), "{err}");
 }
 
@@ -566,11 +569,11 @@ fn a_case_with_the_recursive_operator_passes_and_says_so() {
     println!("Schäfer-Turek 2D-1, recursive operator: C_D {:.4}", measured(&report, "mean_cd"));
 
     // An unknown operator is refused naming the field and the choices.
-    let bad = body.replace("collision = \"recursive\"", "collision = \"cumulant\"");
-    let case = write_case(dir.path(), "st_bad", &bad);
-    let o = run_coarse(&case, &dir.path().join("bad"), false);
-    let (_, err) = text(&o);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let err = refused(
+        dir.path(),
+        "st_bad",
+        &body.replace("collision = \"recursive\"", "collision = \"cumulant\""),
+    );
     assert!(err.contains("cumulant") && err.contains("recursive"), "{err}");
 }
 
@@ -602,9 +605,6 @@ fn a_refined_case_runs_records_its_patch_and_improves_the_drag() {
 
     // A region that leaves the domain is refused before anything runs.
     let bad = refined.replace("regions = [[0.8, 6.0, 0.3, 3.8]]", "regions = [[0.8, 6.0, -1.0, 3.8]]");
-    let case = write_case(dir.path(), "st_bad", &bad);
-    let o = run_coarse(&case, &dir.path().join("bad"), false);
-    let (_, err) = text(&o);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let err = refused(dir.path(), "st_bad", &bad);
     assert!(err.contains("refinement.regions") && err.contains("inside the domain"), "{err}");
 }
