@@ -42,7 +42,16 @@ pub struct Analysis {
     /// The lift spectrum's substantial peaks (at least a quarter of the tallest): `[frequency,
     /// height relative to the tallest]`, tallest first, at most [`MAX_PEAKS`].
     pub lift_peaks: Vec<[f64; 2]>,
+    /// The window cut into consecutive runs of whole periods, each analysed alone (see
+    /// [`batches`]); empty when the window holds too few periods.
+    pub batches: Vec<Analysis>,
 }
+
+/// Batches the averaging window is cut into, at most.
+pub const BATCHES: usize = 4;
+
+/// Whole periods a batch needs at least.
+pub const MIN_BATCH_PERIODS: usize = 3;
 
 /// The lift spectrum over the window: `(frequencies, amplitudes)`.
 pub fn spectrum(t: &[f64], signal: &[f64]) -> (Vec<f64>, Vec<f64>) {
@@ -200,37 +209,11 @@ pub fn analyse(t: &[f64], cd: &[f64], cl: &[f64], t_start: f64) -> Analysis {
         }
     }
     if crossings.len() >= 3 && std > 1e-9 {
-        let periods = crossings.len() - 1;
-        let (t0, j0) = crossings[0];
-        let (t1, j1) = crossings[periods];
-        let period = (t1 - t0) / periods as f64;
-        let cd_w = &cd[j0..j1];
-        let cl_w = &cl[j0..j1];
-        let m_cl_w = mean(cl_w);
-        let mut amp_l = 0.0;
-        let mut amp_d = 0.0;
-        for p in 0..periods {
-            let (a, b) = (crossings[p].1, crossings[p + 1].1);
-            let (lo, hi) = cl[a..b]
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-            amp_l += 0.5 * (hi - lo);
-            let (lo, hi) = cd[a..b]
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-            amp_d += 0.5 * (hi - lo);
-        }
         Analysis {
-            strouhal: Some(1.0 / period),
             strouhal_spectral,
-            mean_cd: mean(cd_w),
-            mean_cl: m_cl_w,
-            cl_amplitude: amp_l / periods as f64,
-            cl_rms: (cl_w.iter().map(|v| (v - m_cl_w).powi(2)).sum::<f64>() / cl_w.len() as f64).sqrt(),
-            cd_amplitude: amp_d / periods as f64,
-            periods,
-            window: [t0, t1],
             lift_peaks: peaks,
+            batches: batches(cd, cl, &crossings),
+            ..over_periods(cd, cl, &crossings)
         }
     } else {
         let (lo, hi) = cl
@@ -250,8 +233,76 @@ pub fn analyse(t: &[f64], cd: &[f64], cl: &[f64], t_start: f64) -> Analysis {
             periods: 0,
             window: [t[0], t[n - 1]],
             lift_peaks: peaks,
+            batches: vec![],
         }
     }
+}
+
+/// Frequency (periods over their duration), means, lift rms and amplitudes (half the range per
+/// period, averaged) over the whole periods between the first and the last of `crossings`
+/// (upward crossings as `(time, index of the sample after it)`, at least two).
+fn over_periods(cd: &[f64], cl: &[f64], crossings: &[(f64, usize)]) -> Analysis {
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let periods = crossings.len() - 1;
+    let (t0, j0) = crossings[0];
+    let (t1, j1) = crossings[periods];
+    let cd_w = &cd[j0..j1];
+    let cl_w = &cl[j0..j1];
+    let m_cl_w = mean(cl_w);
+    let half_range = |v: &[f64]| {
+        let (lo, hi) = v
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        0.5 * (hi - lo)
+    };
+    let (mut amp_l, mut amp_d) = (0.0, 0.0);
+    for p in crossings.windows(2) {
+        let (a, b) = (p[0].1, p[1].1);
+        amp_l += half_range(&cl[a..b]);
+        amp_d += half_range(&cd[a..b]);
+    }
+    Analysis {
+        strouhal: Some(1.0 / ((t1 - t0) / periods as f64)),
+        strouhal_spectral: None,
+        mean_cd: mean(cd_w),
+        mean_cl: m_cl_w,
+        cl_amplitude: amp_l / periods as f64,
+        cl_rms: (cl_w.iter().map(|v| (v - m_cl_w).powi(2)).sum::<f64>() / cl_w.len() as f64).sqrt(),
+        cd_amplitude: amp_d / periods as f64,
+        periods,
+        window: [t0, t1],
+        lift_peaks: vec![],
+        batches: vec![],
+    }
+}
+
+/// Batch means (Law & Carson, Oper. Res. 27, 1979; Flyvbjerg & Petersen, J. Chem. Phys. 91,
+/// 1989): the window's whole periods cut into [`BATCHES`] consecutive runs of at least
+/// [`MIN_BATCH_PERIODS`] (fewer runs if the window is short, none below two), each analysed alone.
+/// Their scatter measures how far a window of this length pins a chaotic wake's statistics down:
+/// for runs longer than the correlation time, the standard error of the whole window's value is
+/// the runs' standard deviation over `sqrt(runs)`. A limit cycle's runs agree to round-off.
+fn batches(cd: &[f64], cl: &[f64], crossings: &[(f64, usize)]) -> Vec<Analysis> {
+    let periods = crossings.len().saturating_sub(1);
+    let k = (periods / MIN_BATCH_PERIODS).min(BATCHES);
+    if k < 2 {
+        return vec![];
+    }
+    (0..k)
+        .map(|b| over_periods(cd, cl, &crossings[b * periods / k..=(b + 1) * periods / k]))
+        .collect()
+}
+
+/// Standard error of the mean of `values` from their sample standard deviation: `s / sqrt(n)`;
+/// `None` below two values.
+pub fn standard_error(values: &[f64]) -> Option<f64> {
+    let n = values.len();
+    if n < 2 {
+        return None;
+    }
+    let m = values.iter().sum::<f64>() / n as f64;
+    let var = values.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1) as f64;
+    Some((var / n as f64).sqrt())
 }
 
 #[cfg(test)]
@@ -279,6 +330,49 @@ mod tests {
         assert!((a.cl_amplitude - 0.66).abs() < 1e-3);
         assert!((a.cl_rms - 0.66 / 2f64.sqrt()).abs() < 2e-3);
         assert!(a.periods >= 30);
+    }
+
+    /// Batch means: a limit cycle's four batches agree (standard error at round-off); a lift that
+    /// sheds at St 0.10 for the first half of the window and 0.12 for the second gives batches
+    /// from 0.10 to 0.12 and about the standard error of 0.10, 0.10, 0.12, 0.12 (`std / 2 =
+    /// 0.0058`); a window
+    /// of five periods is too short to batch.
+    #[test]
+    fn batches_measure_the_scatter_of_the_window() {
+        use std::f64::consts::PI;
+        let dt = 0.01;
+        let t: Vec<f64> = (0..20_000).map(|j| j as f64 * dt).collect();
+        let cd = vec![1.4; t.len()];
+        let cl: Vec<f64> = t.iter().map(|t| (2.0 * PI * 0.1957 * t).sin()).collect();
+        let a = analyse(&t, &cd, &cl, 20.0);
+        assert_eq!(a.batches.len(), BATCHES);
+        let st: Vec<f64> = a.batches.iter().map(|b| b.strouhal.unwrap()).collect();
+        assert!(st.iter().all(|s| (s - 0.1957).abs() < 1e-4), "{st:?}");
+        assert!(standard_error(&st).unwrap() < 1e-5);
+        // The batches partition the window into whole periods.
+        assert_eq!(a.batches.iter().map(|b| b.periods).sum::<usize>(), a.periods);
+        assert_eq!(a.batches[0].window[0], a.window[0]);
+        assert_eq!(a.batches[BATCHES - 1].window[1], a.window[1]);
+        // Phase-continuous switch from 0.10 to 0.12 at t = 200 (20 periods of each).
+        let phase = |t: f64| if t < 200.0 { 0.10 * t } else { 20.0 + 0.12 * (t - 200.0) };
+        let t: Vec<f64> = (0..36_667).map(|j| j as f64 * dt).collect();
+        let cd = vec![1.4; t.len()];
+        let cl: Vec<f64> = t.iter().map(|&t| (2.0 * PI * phase(t)).sin()).collect();
+        let a = analyse(&t, &cd, &cl, 0.0);
+        let st: Vec<f64> = a.batches.iter().map(|b| b.strouhal.unwrap()).collect();
+        assert_eq!(st.len(), 4, "{st:?}");
+        // The middle split falls within a period of the switch: the outer batches are pure.
+        assert!((st[0] - 0.10).abs() < 1e-3 && (st[3] - 0.12).abs() < 1e-3, "{st:?}");
+        assert!(st.windows(2).all(|w| w[1] >= w[0] - 1e-9), "{st:?}");
+        let se = standard_error(&st).unwrap();
+        assert!((0.0045..0.0065).contains(&se), "{se} from {st:?}");
+        // Five periods: one batch of at least three would be all there is.
+        let t: Vec<f64> = (0..5_200).map(|j| j as f64 * dt).collect();
+        let cl: Vec<f64> = t.iter().map(|t| (2.0 * PI * 0.1 * t).sin()).collect();
+        let a = analyse(&t, &cd[..t.len()], &cl, 0.0);
+        assert!(a.periods >= 3 && a.periods < 2 * MIN_BATCH_PERIODS, "{}", a.periods);
+        assert!(a.batches.is_empty());
+        assert_eq!(standard_error(&[1.0]), None);
     }
 
     #[test]

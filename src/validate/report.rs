@@ -6,7 +6,7 @@ use std::path::Path;
 use plotters::style::RGBColor;
 use serde::{Deserialize, Serialize};
 
-use super::analysis::{analyse, spectrum, Analysis};
+use super::analysis::{analyse, spectrum, standard_error, Analysis};
 use super::case::{Component, LoadedCase, Quantity};
 use super::run::{RunOutput, RunStatus};
 use crate::report::manifest::{manifest, Manifest};
@@ -65,6 +65,28 @@ pub struct QuantityResult {
     /// `None` for quantities measured without a reference.
     pub pass: Option<bool>,
     pub source: Option<String>,
+    /// The quantity over each batch of consecutive whole periods of the window (batch means,
+    /// [`crate::validate::analysis::BATCHES`]); absent for short windows and in reports written
+    /// before it was added.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub batches: Vec<f64>,
+    /// Standard error of `measured` from the batches' scatter: how far this window's length pins
+    /// the value down (sampling, not discretisation).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub standard_error: Option<f64>,
+}
+
+impl QuantityResult {
+    /// The standard error as the table prints it: relative to the measured value (`±4.1%`) for
+    /// relative tolerances and quantities without a reference, absolute (`±0.0040`) otherwise.
+    pub fn standard_error_text(&self) -> Option<String> {
+        let se = self.standard_error?;
+        match (self.tolerance_kind.as_deref(), self.measured) {
+            (Some("absolute"), _) => Some(format!("±{se:.4}")),
+            (_, Some(m)) if m != 0.0 => Some(format!("±{:.1}%", 100.0 * se / m.abs())),
+            _ => Some(format!("±{se:.4}")),
+        }
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -139,6 +161,12 @@ impl ValidationReport {
         let mut quantities = Vec::new();
         for &q in &case.measure.quantities {
             let m = if diverged { None } else { measured(&a, q, out) };
+            let batches: Vec<f64> = if m.is_some() {
+                a.batches.iter().map_while(|b| measured(b, q, out)).collect()
+            } else {
+                vec![]
+            };
+            let batches = if batches.len() == a.batches.len() { batches } else { vec![] };
             let r = case.reference.iter().find(|r| r.quantity == q);
             let (reference, tolerance, kind, deviation, pass, source) = match r {
                 None => (None, None, None, None, None, None),
@@ -175,6 +203,8 @@ impl ValidationReport {
                 deviation,
                 pass,
                 source,
+                standard_error: standard_error(&batches),
+                batches,
             });
         }
         let (status, message) = match &out.status {
@@ -236,6 +266,33 @@ impl ValidationReport {
         }
     }
 
+    /// A line for each quantity whose standard error from the batches is more than half its
+    /// tolerance: twice the standard error is about the 95 % half-width, so this window's length
+    /// cannot tell a pass from a fail, whatever the solver does.
+    pub fn sampling_notes(&self) -> Vec<String> {
+        self.quantities
+            .iter()
+            .filter_map(|q| {
+                let (se, tol) = (q.standard_error?, q.tolerance?);
+                let se_in_tol_units = if q.tolerance_kind.as_deref() == Some("absolute") {
+                    se
+                } else {
+                    se / q.reference?.abs()
+                };
+                (2.0 * se_in_tol_units > tol).then(|| {
+                    let values: Vec<String> = q.batches.iter().map(|v| format!("{v:.4}")).collect();
+                    format!(
+                        "sampling: {} over {} batches of the window is {} (standard error {}), more than half the tolerance: a longer window is needed to decide it",
+                        q.name,
+                        q.batches.len(),
+                        values.join(", "),
+                        q.standard_error_text().unwrap_or_default()
+                    )
+                })
+            })
+            .collect()
+    }
+
     /// A line for a lift that is no limit cycle: its spectrum's substantial peaks are not all
     /// harmonics of the frequency measured, so a Strouhal number summarises a broadband wake.
     pub fn broadband_note(&self) -> Option<String> {
@@ -251,7 +308,8 @@ impl ValidationReport {
         ))
     }
 
-    /// Plain-text table: quantity, measured, reference, deviation, pass/fail.
+    /// Plain-text table: quantity, measured, its standard error, reference, deviation, tolerance,
+    /// pass/fail; then notes (failures, a broadband lift, a window too short to decide).
     pub fn table(&self) -> String {
         let mut s = format!(
             "{} [{}] level {} ({} x {} cells, {} cells/L, tau {:.5}, Ma {:.3}): {}\n",
@@ -284,8 +342,8 @@ impl ValidationReport {
             );
         }
         s += &format!(
-            "  {:<14} {:>10} {:>10} {:>10} {:>10}  {}\n",
-            "quantity", "measured", "reference", "deviation", "tolerance", "result"
+            "  {:<14} {:>10} {:>9} {:>10} {:>10} {:>10}  {}\n",
+            "quantity", "measured", "s.e.", "reference", "deviation", "tolerance", "result"
         );
         for q in &self.quantities {
             let num = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
@@ -305,9 +363,10 @@ impl ValidationReport {
                 None => "(info)",
             };
             s += &format!(
-                "  {:<14} {:>10} {:>10} {:>10} {:>10}  {}\n",
+                "  {:<14} {:>10} {:>9} {:>10} {:>10} {:>10}  {}\n",
                 q.name,
                 num(q.measured),
+                q.standard_error_text().unwrap_or_else(|| "-".into()),
                 num(q.reference),
                 dev,
                 tol,
@@ -318,6 +377,9 @@ impl ValidationReport {
             s += &format!("  note: {m}\n");
         }
         if let Some(line) = self.broadband_note() {
+            s += &format!("  note: {line}\n");
+        }
+        for line in self.sampling_notes() {
             s += &format!("  note: {line}\n");
         }
         s += &format!(
@@ -385,6 +447,75 @@ pub fn write_plots(r: &ValidationReport, out: &RunOutput, dir: &Path) -> Result<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The bundled square Re 200 case's report (spin-up 60 L/U) for a synthetic force history
+    /// sampled every 0.01 L/U up to 220 L/U: drag 1.46, lift `sin(2 pi phase(t))`.
+    fn synthetic_report(phase: &dyn Fn(f64) -> f64) -> ValidationReport {
+        use crate::validate::run::{Field, RunStatus};
+        let c = crate::validate::bundled()
+            .unwrap()
+            .into_iter()
+            .find(|c| c.case.case.name == "square_re200")
+            .unwrap();
+        let plan = crate::validate::plan(&c, crate::validate::Level::Coarse).unwrap();
+        let t: Vec<f64> = (0..22_000).map(|j| j as f64 * 0.01).collect();
+        let out = RunOutput {
+            plan,
+            cd: vec![1.46; t.len()],
+            cl: t.iter().map(|&t| 0.4 * (2.0 * std::f64::consts::PI * phase(t)).sin()).collect(),
+            t,
+            cd_bodies: vec![],
+            cl_bodies: vec![],
+            vorticity: Field {
+                nx: 0,
+                ny: 0,
+                extent: [0.0; 4],
+                values: vec![],
+            },
+            status: RunStatus::Completed,
+            wall_time_s: 0.0,
+            steps: 0,
+            mlups: 0.0,
+        };
+        ValidationReport::from_run(&c, &out, 1)
+    }
+
+    /// Each quantity carries its batch values and their standard error. A limit cycle's are at
+    /// round-off and the table says nothing more; a lift whose frequency alternates between 0.14
+    /// and 0.16 every 40 L/U (six periods, about a batch) has a standard error of about 4 %, more
+    /// than half the 3 % tolerance of St, and the table says the window cannot decide it.
+    #[test]
+    fn the_table_says_when_the_window_is_too_short_to_decide() {
+        let steady = synthetic_report(&|t| 0.15 * t);
+        let st = &steady.quantities[0];
+        assert_eq!(st.name, "strouhal");
+        assert_eq!(st.batches.len(), crate::validate::analysis::BATCHES);
+        assert!(st.standard_error.unwrap() < 1e-5, "{st:?}");
+        assert!(steady.sampling_notes().is_empty());
+        assert!(steady.table().contains("±0.0%"), "{}", steady.table());
+        // 0.14 on [60, 100), 0.16 on [100, 140), ...: the phase, integrated piecewise.
+        let f = |k: i64| if k % 2 == 0 { 0.14 } else { 0.16 };
+        let phase = |t: f64| {
+            let k = ((t + 20.0) / 40.0).floor() as i64;
+            (0..k).map(|j| 40.0 * f(j)).sum::<f64>() - 20.0 * f(0) + f(k) * (t + 20.0 - 40.0 * k as f64)
+        };
+        let wandering = synthetic_report(&phase);
+        println!("{}", wandering.table());
+        let st = &wandering.quantities[0];
+        let se = st.standard_error.unwrap() / st.measured.unwrap();
+        assert!((0.02..0.045).contains(&se), "{st:?}");
+        let notes = wandering.sampling_notes();
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(
+            notes[0].starts_with("sampling: strouhal over 4 batches of the window is 0.1"),
+            "{notes:?}"
+        );
+        assert!(wandering.table().contains(&format!("note: {}", notes[0])));
+        // Serialised with the report, and read back.
+        let json = serde_json::to_string(&wandering).unwrap();
+        let back: ValidationReport = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.quantities[0].batches, st.batches);
+    }
 
     /// A committed report (written before `lift_peaks` existed) still reads; with the peaks of a
     /// broadband lift (square cylinder, Re 1000, characteristic inlet run) its table says so, and
