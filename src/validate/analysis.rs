@@ -20,6 +20,10 @@
 //! fundamental and all harmonics), not its overall mean: a chaotic wake (the pinball at Re 150)
 //! drifts slowly, and cycles riding on a drift never cross the overall mean, so counting
 //! crossings of the mean missed a tenth of them (f0 0.1055 against a spectral peak at 0.1195).
+//!
+//! Every statistic is also taken over up to [`BATCHES`] consecutive runs of whole periods of the
+//! window ([`batches`]): their scatter is the sampling error of a window of this length, which for
+//! a chaotic wake can exceed the tolerance a reference is checked to.
 
 use realfft::RealFftPlanner;
 use serde::Serialize;
