@@ -267,8 +267,9 @@ impl ValidationReport {
     }
 
     /// A line for each quantity whose standard error from the batches is more than half its
-    /// tolerance: twice the standard error is about the 95 % half-width, so this window's length
-    /// cannot tell a pass from a fail, whatever the solver does.
+    /// tolerance: twice the standard error is about the 95 % half-width (with four batches
+    /// Student's t gives 3.2 times it, so the note is, if anything, too rarely shown), so this
+    /// window's length cannot tell a pass from a fail, whatever the solver does.
     pub fn sampling_notes(&self) -> Vec<String> {
         self.quantities
             .iter()
@@ -517,23 +518,29 @@ mod tests {
         assert_eq!(back.quantities[0].batches, st.batches);
     }
 
-    /// A committed report (written before `lift_peaks` existed) still reads; with the peaks of a
-    /// broadband lift (square cylinder, Re 1000, characteristic inlet run) its table says so, and
-    /// with a harmonic series it does not.
+    /// A report written before `lift_peaks` existed still reads (the committed square-cylinder
+    /// Re 1000 report with the field taken out) and has no note; the committed report itself, a
+    /// broadband wake, names its peaks in its table, tallest first; a harmonic series does not.
     #[test]
     fn a_broadband_lift_is_named_in_the_table() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/validation/square_re1000.json");
         let text = std::fs::read_to_string(path).unwrap();
+        let mut old: serde_json::Value = serde_json::from_str(&text).unwrap();
+        old["analysis"].as_object_mut().unwrap().remove("lift_peaks");
+        let old: ValidationReport = serde_json::from_value(old).unwrap();
+        assert!(old.analysis.lift_peaks.is_empty());
+        assert!(old.broadband_note().is_none());
         let mut r: ValidationReport = serde_json::from_str(&text).unwrap();
-        assert!(r.analysis.lift_peaks.is_empty());
-        assert!(r.broadband_note().is_none());
-        r.analysis.strouhal_spectral = Some(0.0917);
-        r.analysis.lift_peaks = vec![[0.0917, 1.0], [0.0833, 0.93], [0.1, 0.51], [0.2, 0.49]];
+        let peaks = r.analysis.lift_peaks.clone();
+        assert!(peaks.len() >= 3, "{peaks:?}");
+        assert_eq!(peaks[0][1], 1.0);
         let table = r.table();
-        assert!(
-            table.contains("note: broadband lift, not a limit cycle: spectral peaks at St 0.092 (1.00), 0.083 (0.93)"),
-            "{table}"
+        let first = format!(
+            "note: broadband lift, not a limit cycle: spectral peaks at St {:.3} (1.00), {:.3} ({:.2})",
+            peaks[0][0], peaks[1][0], peaks[1][1]
         );
+        assert!(table.contains(&first), "{table}");
+        r.analysis.strouhal_spectral = Some(0.0917);
         r.analysis.lift_peaks = vec![[0.0917, 1.0], [0.1834, 0.6], [0.2751, 0.3]];
         assert!(r.broadband_note().is_none());
         assert!(!r.table().contains("broadband"));
