@@ -4,7 +4,7 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 use common::python;
@@ -25,7 +25,7 @@ fn ok(o: &Output) -> String {
 }
 
 fn load_with_python(ds: &Path, runs: &Path, hf_home: &Path) -> serde_json::Value {
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/read_hf.py");
+    let script = common::repo().join("tests/read_hf.py");
     let o = Command::new(python())
         .arg(script)
         .arg(ds)
@@ -80,10 +80,8 @@ fn export_loads_with_datasets_and_pandas_and_matches_the_mcap_files() {
     ]));
     let report: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(report["schema"], "hgym/hf-export/v1");
-    let schema: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("schemas/hf-export.schema.json")).unwrap(),
-    )
-    .unwrap();
+    let schema: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(common::repo().join("schemas/hf-export.schema.json")).unwrap()).unwrap();
     let on_disk: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(ds.join("hgym_export.json")).unwrap()).unwrap();
     assert_eq!(on_disk, report);
     let errors: Vec<String> = jsonschema::validator_for(&schema)

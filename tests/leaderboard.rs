@@ -1,6 +1,8 @@
 //! `hgym leaderboard` rebuilds the committed leaderboard from the committed results: the same
 //! entries as `results/leaderboard.json`, the markdown table and one bar chart per group.
 
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 
@@ -21,7 +23,7 @@ fn copy_results(from: &Path, to: &Path) {
 
 #[test]
 fn leaderboard_rebuilds_the_committed_one_from_the_committed_results() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = &common::repo();
     let tmp = tempfile::tempdir().unwrap();
     let results = tmp.path().join("results");
     copy_results(&root.join("results"), &results);

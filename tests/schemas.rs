@@ -4,9 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-fn repo() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
+mod common;
+use common::repo;
 
 fn schema_file(path: &Path, v: &serde_json::Value) -> Option<&'static str> {
     let by_field = match v.get("schema").and_then(|s| s.as_str()) {

@@ -226,7 +226,7 @@ fn bad_training_input_is_named() {
 fn plot_draws_several_committed_runs_and_names_bad_folders() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("c.png");
-    let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let repo = common::repo();
     let a = repo.join("results/train/Cylinder_2D_Re100-td3-coarse/seed0");
     let b = repo.join("results/train/Cylinder_2D_Re100-ppo-coarse/seed0");
     let o = hgym(&[

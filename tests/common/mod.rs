@@ -6,6 +6,15 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// The checkout under test. Read at run time (cargo sets `CARGO_MANIFEST_DIR` when it runs a
+/// test), not baked in with `env!`: cargo reuses a build from another clone of the same tree
+/// that shares `CARGO_TARGET_DIR` (CI's fresh clone), and a baked path would point there.
+pub fn repo() -> PathBuf {
+    std::env::var_os("CARGO_MANIFEST_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")))
+}
+
 /// The Python interpreter with `mcap`, pandas, pyarrow and `datasets` installed.
 pub fn python() -> PathBuf {
     if let Some(p) = std::env::var_os("HGYM_PYTHON") {
@@ -23,7 +32,7 @@ pub fn python() -> PathBuf {
 
 /// The Python `mcap` reader's summary of a trajectory (tests/read_mcap.py), or its error text.
 pub fn read_mcap(file: &Path) -> Result<serde_json::Value, String> {
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/read_mcap.py");
+    let script = repo().join("tests/read_mcap.py");
     let o = Command::new(python()).arg(script).arg(file).output().expect("run python");
     if !o.status.success() {
         return Err(String::from_utf8_lossy(&o.stderr).into_owned());
