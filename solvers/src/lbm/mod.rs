@@ -30,6 +30,6 @@ pub use collision::Collision;
 pub use domain::{Edge, Grid, Side, Sides};
 pub use error::LbmError;
 pub use refine::{Patch, Refined};
-pub use solver::{D2q9, D2q9Config, WallPoint};
+pub use solver::{D2q9, D2q9Config, WallPoint, ON_WALL};
 pub use sponge::Sponge;
 pub use units::Units;

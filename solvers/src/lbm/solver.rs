@@ -16,6 +16,17 @@ use super::lattice::{CX, CY, OPP, Q};
 use super::sponge::{apply_row, Sponge, SpongePlan};
 use crate::geometry::Shape;
 
+/// A node within `ON_WALL` grid spacings of a body's wall (`sdf <= ON_WALL dx`) is a wall node:
+/// solid, and the links that reach it carry `q = 1`. Without the margin a wall that passes
+/// through a row of nodes (a square's face on a node-centred grid, or on a refined patch whose
+/// nodes fall on the coarse cell faces) was split by the rounding of `origin + i dx`: some of its
+/// nodes solid, the others fluid with `q` clamped to 1e-3, and the flow saw a ragged wall. The
+/// square at Re 200 with 24 cells per side and its faces on nodes gave St 0.1633, C_D 1.443,
+/// C_L' 0.361 against 0.1572, 1.470, 0.420 with its faces between nodes (71 of the 96 face
+/// nodes solid). The margin is far above the rounding of positions (1e-15 relative) and far
+/// below any distance the scheme resolves.
+pub const ON_WALL: f64 = 1e-9;
+
 /// Everything needed to build a [`D2q9`]. Plain data: threads are whatever rayon pool the step
 /// runs in, and never change the result.
 #[derive(Clone, Debug)]
@@ -271,7 +282,8 @@ impl D2q9 {
         let periodic_y = s.south == Side::Periodic;
         let grid = cfg.grid;
 
-        // Solid nodes.
+        // Solid nodes: inside a body, or on its wall (see `ON_WALL`).
+        let on_wall = ON_WALL * grid.dx;
         let mut solid = vec![false; nx * ny];
         let mut owner = vec![u16::MAX; nx * ny];
         for (b, body) in bodies.iter().enumerate() {
@@ -282,7 +294,7 @@ impl D2q9 {
             let hi_y = (((bb[3] - grid.origin[1]) / grid.dx).ceil().min((ny - 1) as f64)).max(0.0) as usize;
             for y in lo_y.min(ny - 1)..=hi_y {
                 for x in lo_x.min(nx - 1)..=hi_x {
-                    if body.sdf(grid.position(x as f64, y as f64)) <= 0.0 && !solid[y * nx + x] {
+                    if body.sdf(grid.position(x as f64, y as f64)) <= on_wall && !solid[y * nx + x] {
                         solid[y * nx + x] = true;
                         owner[y * nx + x] = b as u16;
                     }
@@ -335,7 +347,11 @@ impl D2q9 {
                     let a = grid.position(x as f64, y as f64);
                     let bpt = grid.position(x as f64 + CX[i] as f64, y as f64 + CY[i] as f64);
                     let body = &bodies[b];
-                    let q = if body.sdf(bpt) <= 0.0 { body.wall_fraction(a, bpt) } else { 0.5 };
+                    let q = if body.sdf(bpt) <= on_wall {
+                        body.wall_fraction(a, bpt)
+                    } else {
+                        0.5
+                    };
                     let q = q.clamp(1e-3, 1.0);
                     let wp = [a[0] + q * (bpt[0] - a[0]), a[1] + q * (bpt[1] - a[1])];
                     links.push(Link {
