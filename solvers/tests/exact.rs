@@ -134,8 +134,10 @@ fn bouzidi_poiseuille_error(m: usize, q: f64, collision: Collision) -> (f64, f64
 fn curved_walls_converge_at_second_order_for_every_fraction() {
     for collision in [Collision::Bgk, Collision::Regularized] {
         for q in [0.25, 0.5, 1.0] {
-            let runs: Vec<(f64, f64)> =
-                [8usize, 16, 32].iter().map(|&m| bouzidi_poiseuille_error(m, q, collision)).collect();
+            let runs: Vec<(f64, f64)> = [8usize, 16, 32]
+                .iter()
+                .map(|&m| bouzidi_poiseuille_error(m, q, collision))
+                .collect();
             for w in runs.windows(2) {
                 let order = (w[0].1 / w[1].1).ln() / (w[1].0 / w[0].0).ln();
                 println!(
