@@ -383,13 +383,16 @@ impl ValidationReport {
         for line in self.sampling_notes() {
             s += &format!("  note: {line}\n");
         }
+        let averaged = match self.analysis.periods {
+            0 => "no shedding (steady lift), means".to_string(),
+            p => format!("{p} whole periods averaged"),
+        };
         s += &format!(
-            "  {} of {} steps in {:.1} s ({:.0} MLUPS), {} whole periods averaged over t = [{:.1}, {:.1}]\n",
+            "  {} of {} steps in {:.1} s ({:.0} MLUPS), {averaged} over t = [{:.1}, {:.1}]\n",
             self.parameters.steps_run,
             self.parameters.steps_planned,
             self.manifest.wall_time_s,
             self.parameters.mlups,
-            self.analysis.periods,
             self.analysis.window[0],
             self.analysis.window[1]
         );
