@@ -66,10 +66,7 @@ pub struct Case {
     pub measure: MeasureSpec,
     /// Absorbing layers (`[[sponge]]`) that let pressure waves leave the domain: without them the
     /// waves of the impulsive start stay trapped between a velocity inlet, an outlet and periodic
-    /// sides, where the weak viscosity at Re >= 30 takes hundreds of L/U to damp them. One at the
-    /// inlet is enough (the waves reflect once off the pressure outlet, then meet it); one across
-    /// the outlet relaxes the wake to the free stream and biases a broadband wake (square cylinder
-    /// at Re 1000: St 0.109 with it, 0.122 without; `benchmarks/validation/STUDIES.md`).
+    /// sides, where the weak viscosity at Re >= 30 takes hundreds of L/U to damp them.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub sponge: Vec<SpongeSpec>,
     /// Local grid refinement (`[refinement]`): a rectangle around the bodies solved on a grid

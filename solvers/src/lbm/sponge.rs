@@ -12,12 +12,6 @@
 //! the absorbing-layer technique of Israeli & Orszag (J. Comput. Phys. 41, 1981), used for LBM
 //! by e.g. Xu & Sagaut (J. Comput. Phys. 245, 2013). The quadratic ramp keeps the layer's own
 //! reflection small; the target is the far-field state the edge stands for (free stream).
-//!
-//! Where a wake leaves the domain that target is wrong: the layer fills the wake's velocity
-//! deficit, a momentum source that pushes the wake like a fan. A broadband wake notices: the
-//! square cylinder at Re 1000 sheds at St 0.109 with a layer 27 D behind it and 0.122 without
-//! (`benchmarks/validation/STUDIES.md`), while limit cycles barely move. Line inflow edges and
-//! edges the flow runs along with layers, not outflows crossed by a wake.
 
 use super::collision::equilibrium;
 use super::domain::Edge;
