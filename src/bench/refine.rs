@@ -148,6 +148,7 @@ pub fn bench_refine(opts: &RefineBenchOptions, progress: &mut dyn FnMut(&str)) -
             let rate = time_steps(opts.seconds, |k| refined.advance(k).map_err(|e| e.to_string()))?;
             let updates = refined.node_updates_per_step();
             let refined_mlups = rate * updates as f64 / 1e6;
+            refined.sync();
             let t = refined.time() as f64;
             let check_error = [
                 check(refined.coarse(), 0.0, 1.0, n, t),

@@ -349,6 +349,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     let wall = started.elapsed().as_secs_f64();
     let steps = solver.time();
     let mlups = (solver.node_updates_per_step() as f64 * steps as f64) / wall.max(1e-9) / 1e6;
+    solver.sync();
     let vorticity = vorticity_field(solver.coarse(), &plan.units, [d.x[0], d.x[1], d.y[0], d.y[1]]);
     Ok(RunOutput {
         plan: plan.clone(),
@@ -401,7 +402,14 @@ impl Grids {
         }
     }
 
-    /// The grid over the whole domain.
+    /// Gives the coarse grid the fine solution under the patches (see `Refined::sync`).
+    fn sync(&mut self) {
+        if let Grids::Refined(r) = self {
+            r.sync();
+        }
+    }
+
+    /// The grid over the whole domain (call `sync` first to read it under the patches).
     fn coarse(&self) -> &D2q9 {
         match self {
             Grids::Uniform(s) => s,
