@@ -17,8 +17,8 @@ use hgym_solvers::lbm::{D2q9, D2q9Config, Grid, Side, Sides, ON_WALL};
 fn every_node_on_a_face_is_solid() {
     let n = 24usize;
     let dx = 1.0 / n as f64;
-    // The square_re200 grid ([0, 60] x [-20, 20], cell-centred nodes), cut at x = 23 to keep the
-    // test small: the node positions near the square are the same floats.
+    // The grid square_re200 had until stop 30 ([0, 60] x [-20, 20], cell-centred nodes), cut at
+    // x = 23 to keep the test small: the node positions near the square are the same floats.
     let (nx, ny) = (23 * n, 40 * n);
     let sides = Sides {
         west: Side::Periodic,
