@@ -14,7 +14,10 @@ start=$(date +%s)
 step() {
   local name=$1; shift
   local t0=$(date +%s)
-  echo "== $name: $*" | tee -a "$LOG"
+  # The command as a user types it: `hgym ...`, not this machine's path to the binary.
+  local shown="$*"
+  [ "$1" = "$HGYM" ] && shown="hgym ${*:2}"
+  echo "== $name: $shown" | tee -a "$LOG"
   if "$@" > "$OUT/$name.txt" 2>>"$LOG"; then status=ok; else status="FAILED ($?)"; failed=$((failed + 1)); fi
   echo "   $status in $(( $(date +%s) - t0 )) s" | tee -a "$LOG"
 }
@@ -43,8 +46,18 @@ total=$(( $(date +%s) - start ))
   echo "## leaderboard lines that changed"
   git diff -U0 -- results/LEADERBOARD.md | grep -E "^[-+]\|" || echo "(none)"
   echo
-  echo "## validation status"
-  grep -hE "^\s*(pass|FAIL)|^[a-z_0-9]+ \(" "$OUT"/validate-*.txt | head -40
+  echo "## validation: every case of every family"
+  # Flow cases print `<case> [<family>] level <level> (...): PASS|FAIL|DIVERGED`; the Kolmogorov
+  # case prints `kolmogorov_re40 (...)` and one `pass`/`FAIL` line per check.
+  grep -hE "^[A-Za-z0-9_-]+ \[[a-z_]+\] level " "$OUT"/validate-*.txt | sed -E 's/ \(.*\): / /'
+  grep -hE "^kolmogorov_[a-z0-9_]+ |^  (pass|FAIL) " "$OUT"/validate-kolmogorov.txt | sed -E 's/ \(.*//'
+  echo
+  echo "## failing cases"
+  failing=$(
+    grep -hE "^[A-Za-z0-9_-]+ \[[a-z_]+\] level .*: (FAIL|DIVERGED)" "$OUT"/validate-*.txt | sed -E 's/ \(.*\): / /'
+    if grep -qE "^  FAIL " "$OUT"/validate-kolmogorov.txt; then echo "kolmogorov_re40 FAIL"; fi
+  )
+  echo "${failing:-(none)}"
 } > "$OUT/summary.md"
 cat "$OUT/summary.md"
 exit "$failed"

@@ -10,9 +10,20 @@ use clap::{Args, Parser, Subcommand};
 
 use hgym::bench::{bench_lbm, bench_refine, LbmBenchOptions, RefineBenchOptions};
 
+/// `print!` through [`cli::out::write_out`]: a closed pipe ends the program with exit code 0.
+macro_rules! print {
+    ($($arg:tt)*) => { $crate::cli::out::write_out(format_args!($($arg)*)) };
+}
+
+/// `println!` through [`cli::out::write_out`]: a closed pipe ends the program with exit code 0.
+macro_rules! println {
+    () => { $crate::cli::out::write_out(format_args!("\n")) };
+    ($($arg:tt)*) => { $crate::cli::out::write_out(format_args!("{}\n", format_args!($($arg)*))) };
+}
+
 mod cli;
 use cli::progress::Progress;
-use hgym::validate::{self, Level, LoadedCase, Options, Status, ValidateError};
+use hgym::validate::{Level, ValidateError};
 
 #[derive(Parser)]
 #[command(
@@ -37,13 +48,15 @@ enum Command {
     /// runs any case file (see benchmarks/validation/*.toml for the format). Exit code 0 when
     /// every quantity is within its tolerance, 1 when one is not or the solver diverged, 2 for
     /// bad input (unknown family, malformed file, parameters that cannot run).
-    Validate(ValidateArgs),
+    Validate(cli::validate::ValidateArgs),
     /// Measure solver speed against the machine's limits.
     #[command(subcommand)]
     Bench(BenchCommand),
     /// List environments, print a spec, or calibrate observation statistics.
     ///
-    /// `hgym envs` prints a table of every ID; `hgym envs show ID` prints its full spec as TOML;
+    /// `hgym envs` prints a table of every ID, with how far its uncontrolled flow is from the
+    /// literature at the coarse and default levels (St and mean C_D deviations, measured by
+    /// `hgym validate --env ID --level L --record`); `hgym envs show ID` prints its full spec as TOML;
     /// `hgym envs calibrate ID` runs it uncontrolled and records observation means and scales in
     /// benchmarks/envs/normalization.toml (rebuild to embed them).
     Envs(EnvsArgs),
@@ -67,7 +80,7 @@ enum Command {
     /// MCAP file (e.g. after a kill) into FILE.recovered.mcap.
     #[command(subcommand)]
     Data(DataCommand),
-    /// Turn trajectory files into a dataset: `hgym export --to hf results/train OUT` writes
+    /// Turn trajectory files into a dataset: `hgym export --to hf results/runs OUT` writes
     /// Parquet shards (one row per control step, one config per env) and a dataset card.
     Export(cli::data::ExportArgs),
     /// Upload a dataset folder to the Hugging Face Hub (token from HF_TOKEN or the
@@ -160,30 +173,6 @@ struct RunArgs {
     fields_every: u64,
     #[arg(long)]
     threads: Option<usize>,
-}
-
-#[derive(Args)]
-struct ValidateArgs {
-    /// Family of bundled cases to run (e.g. `cylinder`); omit it with --case or --list.
-    family: Option<String>,
-    /// Case file(s) to run instead of a bundled family (repeatable).
-    #[arg(long = "case", value_name = "FILE")]
-    cases: Vec<PathBuf>,
-    /// Resolution level (cells per reference length as given in each case file).
-    #[arg(long, value_enum, default_value_t = Level::Default)]
-    level: Level,
-    /// Output folder for `<case>.json` and `<case>/*.png`.
-    #[arg(long, default_value = "results/validation")]
-    out: PathBuf,
-    /// Worker threads (default: all cores). Results are bitwise identical for any count.
-    #[arg(long)]
-    threads: Option<usize>,
-    /// Print the reports as a JSON array on stdout instead of tables.
-    #[arg(long)]
-    json: bool,
-    /// List the bundled cases and exit.
-    #[arg(long)]
-    list: bool,
 }
 
 #[derive(Subcommand)]
@@ -290,7 +279,7 @@ fn main() -> ExitCode {
     };
     hgym::env::spin_up::observe_spin_ups(cli::progress::spin_up_progress);
     let result = match cli.command {
-        Command::Validate(args) => run_validate(args),
+        Command::Validate(args) => cli::validate::run(args),
         Command::Bench(BenchCommand::Lbm { json, quick, collision }) => run_bench(json, quick, collision),
         Command::Bench(BenchCommand::Refine { json, quick }) => run_bench_refine(json, quick),
         Command::Bench(BenchCommand::Envs {
@@ -366,6 +355,7 @@ fn main() -> ExitCode {
             eprintln!("error: {e:#}");
             let bad_input = e.chain().any(|c| {
                 c.downcast_ref::<ValidateError>().is_some_and(|v| v.is_bad_input())
+                    || c.downcast_ref::<hgym::fidelity::FidelityError>().is_some_and(|v| v.is_bad_input())
                     || c.downcast_ref::<UsageError>().is_some()
                     || c.downcast_ref::<hgym::env::EnvInputError>().is_some()
             });
@@ -388,80 +378,6 @@ fn thread_pool(threads: Option<usize>) -> Result<(rayon::ThreadPool, usize)> {
         .build()
         .context("cannot start the worker threads")?;
     Ok((pool, n))
-}
-
-fn run_validate(args: ValidateArgs) -> Result<Outcome> {
-    if args.family.as_deref() == Some("kolmogorov") {
-        let (pool, _) = thread_pool(args.threads)?;
-        let case = hgym::validate::kolmogorov::case().map_err(UsageError)?;
-        let pb = Progress::new((case.time / case.sample_interval) as u64, "kolmogorov Re 40");
-        let r = pool
-            .install(|| hgym::validate::kolmogorov::validate(args.level, &args.out, &mut |k, _| pb.set_position(k as u64)))
-            .context("Kolmogorov validation")?;
-        pb.finish_and_clear();
-        if args.json {
-            println!("{}", serde_json::to_string_pretty(&r)?);
-        } else {
-            println!(
-                "kolmogorov_re40 ({}, {}^2, dt {}, {} time units): D/D_lam mean {:.4} std {:.4} max {:.3}; {} bursts above {:.3} ({:.2} % of the time, {:.1} time units each)",
-                r.level, r.n, r.dt, r.time, r.mean_d_over_dlam, r.std_d_over_dlam, r.max_d_over_dlam, r.bursts,
-                r.threshold_d_over_dlam, 100.0 * r.burst_time_fraction, r.mean_burst_duration
-            );
-            for (c, ok) in &r.checks {
-                println!("  {} {c}", if *ok { "pass" } else { "FAIL" });
-            }
-            println!("  results: {}", args.out.join("kolmogorov_re40.json").display());
-        }
-        return Ok(if r.pass { Outcome::Ok } else { Outcome::CheckFailed });
-    }
-    if args.list {
-        for c in validate::bundled()? {
-            println!("{:<10} {:<18} {}", c.case.case.family, c.case.case.name, c.case.case.description);
-        }
-        return Ok(Outcome::Ok);
-    }
-    let cases: Vec<LoadedCase> = match (&args.family, args.cases.is_empty()) {
-        (Some(_), false) => return Err(UsageError("give either a family or --case FILE, not both".into()).into()),
-        (None, true) => {
-            let known = validate::families()?.join(", ");
-            return Err(UsageError(format!(
-                "nothing to validate: name a family ({known}) or give --case FILE; --list shows the bundled cases"
-            ))
-            .into());
-        }
-        (Some(f), true) => validate::family_cases(f)?,
-        (None, false) => args.cases.iter().map(|p| validate::load_file(p)).collect::<Result<_, _>>()?,
-    };
-    // Refuse unrunnable parameters for every case before running any.
-    for c in &cases {
-        validate::plan(c, args.level)?;
-    }
-    let (pool, threads) = thread_pool(args.threads)?;
-    let opts = Options {
-        level: args.level,
-        out: args.out.clone(),
-        threads,
-    };
-    let mut reports = Vec::new();
-    for c in &cases {
-        let plan = validate::plan(c, args.level)?;
-        let pb = Progress::new(plan.total_steps, &c.case.case.name);
-        let report = pool
-            .install(|| validate::validate_case(c, &opts, &mut |done, _| pb.set_position(done)))
-            .with_context(|| format!("validation case '{}'", c.case.case.name))?;
-        pb.finish_and_clear();
-        if !args.json {
-            print!("{}", report.table());
-            println!("  report: {}", args.out.join(format!("{}.json", report.case)).display());
-            println!();
-        }
-        reports.push(report);
-    }
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&reports)?);
-    }
-    let all_pass = reports.iter().all(|r| r.status == Status::Pass);
-    Ok(if all_pass { Outcome::Ok } else { Outcome::CheckFailed })
 }
 
 fn run_bench(json: bool, quick: bool, collision: CollisionArg) -> Result<Outcome> {
@@ -515,33 +431,23 @@ fn run_bench_refine(json: bool, quick: bool) -> Result<Outcome> {
     Ok(if report.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
 }
 
-/// The validation case of the flow behind an environment ID and the status of its report in
-/// `results/validation/` under the working directory (the committed ones when run from the
-/// repository), e.g. `pinball_re100 (pass)`; `-` when no case covers the flow.
-fn validation_status(s: &hgym::env::any::AnySpec) -> String {
-    let base = match s.family() {
-        "cylinder" | "rotary_cylinder" => "cylinder",
-        "pinball" | "jet_pinball" => "pinball",
-        "square_cylinder" => "square",
-        "kolmogorov" => "kolmogorov",
-        _ => return "-".into(),
-    };
-    let name = format!("{base}_re{}", s.reynolds().round() as i64);
-    let bundled = validate::bundled().is_ok_and(|cases| cases.iter().any(|c| c.case.case.name == name));
-    let kolmogorov = hgym::validate::kolmogorov::case().is_ok_and(|c| c.case == name);
-    if !bundled && !kolmogorov {
-        return "-".into();
+/// The committed deviations of `s`'s uncontrolled flow at `level` from the literature
+/// (`hgym validate --env ID --level L --record`), if measured on the flow registered now.
+fn fidelity_entry(s: &hgym::env::any::AnySpec, level: Level) -> Option<&'static hgym::fidelity::Entry> {
+    match s {
+        hgym::env::any::AnySpec::Lbm(spec) => hgym::fidelity::committed(spec, level),
+        hgym::env::any::AnySpec::Kolmogorov(_) => None,
     }
-    let report = std::fs::read_to_string(std::path::Path::new("results/validation").join(format!("{name}.json")))
-        .ok()
-        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok());
-    // Flow-case reports carry `status`; the Kolmogorov report a boolean `pass`.
-    let status = report.and_then(|r| match (&r["status"], &r["pass"]) {
-        (serde_json::Value::String(s), _) => Some(s.clone()),
-        (_, serde_json::Value::Bool(p)) => Some(if *p { "pass" } else { "fail" }.to_string()),
-        _ => None,
-    });
-    format!("{name} ({})", status.as_deref().unwrap_or("no report here"))
+}
+
+/// `St -2.7% C_D +13.7%`; `-` without references (the Kolmogorov flows' check is `hgym validate
+/// kolmogorov`); `not measured`.
+fn fidelity(s: &hgym::env::any::AnySpec, level: Level) -> String {
+    match (s, fidelity_entry(s, level)) {
+        (_, Some(e)) => e.summary(),
+        (hgym::env::any::AnySpec::Lbm(spec), None) if hgym::fidelity::has_reference(spec) => "not measured".into(),
+        _ => "-".into(),
+    }
 }
 
 fn run_envs(args: EnvsArgs) -> Result<Outcome> {
@@ -552,7 +458,6 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
                 hgym::env::any::AnySpec::Lbm(s) => !s.normalization.mean.is_empty(),
                 hgym::env::any::AnySpec::Kolmogorov(s) => s.statistics.u_rms > 0.0,
             };
-            let validation = validation_status;
             if args.json {
                 let rows: Vec<serde_json::Value> = specs
                     .iter()
@@ -561,19 +466,23 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
                             "id": s.id(), "family": s.family(), "dimension": 2, "reynolds": s.reynolds(),
                             "observations": s.obs_dim(), "actions": s.act_dim(), "solver": s.solver(),
                             "differentiable": s.differentiable(),
-                            "calibrated": calibrated(s), "validation": validation(s), "spec_hash": s.hash(),
+                            "calibrated": calibrated(s), "spec_hash": s.hash(),
+                            "fidelity": {
+                                "coarse": fidelity_entry(s, Level::Coarse),
+                                "default": fidelity_entry(s, Level::Default),
+                            },
                         })
                     })
                     .collect();
                 println!("{}", serde_json::to_string_pretty(&rows)?);
             } else {
                 println!(
-                    "{:<30} {:>3} {:>7} {:>5} {:>5} {:<11} {:<10} validation",
-                    "ID", "dim", "Re", "obs", "act", "solver", "calibrated"
+                    "{:<30} {:>3} {:>7} {:>5} {:>5} {:<11} {:<10} {:<22} {}",
+                    "ID", "dim", "Re", "obs", "act", "solver", "calibrated", "vs literature: coarse", "default"
                 );
                 for s in &specs {
                     println!(
-                        "{:<30} {:>3} {:>7} {:>5} {:>5} {:<11} {:<10} {}",
+                        "{:<30} {:>3} {:>7} {:>5} {:>5} {:<11} {:<10} {:<22} {}",
                         s.id(),
                         "2D",
                         s.reynolds(),
@@ -581,7 +490,8 @@ fn run_envs(args: EnvsArgs) -> Result<Outcome> {
                         s.act_dim(),
                         s.solver(),
                         if calibrated(s) { "yes" } else { "no" },
-                        validation(s)
+                        fidelity(s, Level::Coarse),
+                        fidelity(s, Level::Default)
                     );
                 }
             }

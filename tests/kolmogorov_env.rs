@@ -3,7 +3,7 @@
 //! itself, for both objectives.
 
 use hgym::env::kolmogorov::{self, KolmogorovEnv, KolmogorovSpec, Objective};
-use hgym::validate::Level;
+use hgym::flow::Level;
 use hgym_agents::{DifferentiableEnv, Env, EnvError};
 
 fn short(mut s: KolmogorovSpec, actions: usize) -> KolmogorovSpec {

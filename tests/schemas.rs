@@ -2,10 +2,10 @@
 //! file's `schema` field, or by its name for the files that have none: `policy.json`, rollout
 //! `metrics.json`). A JSON file without a schema fails the test.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 mod common;
-use common::repo;
+use common::{files_under, repo};
 
 fn schema_file(path: &Path, v: &serde_json::Value) -> Option<&'static str> {
     let by_field = match v.get("schema").and_then(|s| s.as_str()) {
@@ -29,18 +29,6 @@ fn schema_file(path: &Path, v: &serde_json::Value) -> Option<&'static str> {
     by_field
 }
 
-fn json_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    for e in entries.flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            json_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "json") {
-            out.push(p);
-        }
-    }
-}
-
 #[test]
 fn every_result_json_matches_its_schema() {
     let schemas = repo().join("schemas");
@@ -56,8 +44,7 @@ fn every_result_json_matches_its_schema() {
         );
         loaded.insert(name, v);
     }
-    let mut files = vec![];
-    json_files(&repo().join("results"), &mut files);
+    let files = files_under(&repo().join("results"), &|p| p.extension().is_some_and(|x| x == "json"));
     assert!(files.len() > 20, "expected the committed results");
     let mut counts = std::collections::BTreeMap::new();
     for f in &files {

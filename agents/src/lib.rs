@@ -13,6 +13,7 @@
 
 pub mod baselines;
 pub mod buffer;
+pub mod check;
 pub mod ddpg;
 mod env;
 pub mod gppo;
@@ -28,5 +29,6 @@ mod spaces;
 pub mod td3;
 pub mod toy;
 
+pub use check::{check_env, Violation};
 pub use env::{checked_action, DifferentiableEnv, Env, EnvError, Info, StepResult};
 pub use spaces::BoxSpace;

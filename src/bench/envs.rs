@@ -8,7 +8,7 @@ use hgym_agents::Env;
 use serde::{Deserialize, Serialize};
 
 use crate::env::{registry, LbmEnv};
-use crate::validate::case::Level;
+use crate::flow::Level;
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct EnvBenchRow {

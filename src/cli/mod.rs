@@ -2,6 +2,8 @@
 //! `export`, `push`; progress reports for long runs.
 
 pub mod data;
+pub mod out;
 pub mod progress;
 
 pub mod train;
+pub mod validate;

@@ -8,7 +8,7 @@ use clap::Args;
 use hgym::train::config::TrainConfig;
 use hgym::train::eval::{evaluate, parse_policy, uncontrolled_c_d, EvalReport, NamedPolicy};
 use hgym::train::{resolve_spec, resume_options, summarize, Ending, TrainError, TrainOptions};
-use hgym::validate::Level;
+use hgym::flow::Level;
 use hgym_agents::baselines::BaselinePolicy;
 use hgym_agents::learn::Algo;
 use hgym_agents::policy::Policy;

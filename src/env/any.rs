@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::kolmogorov::{KolmogorovEnv, KolmogorovSpec};
 use super::{EnvInputError, EnvSpec, LbmEnv};
-use crate::validate::case::Level;
+use crate::flow::Level;
 
 /// A spec of any family (serialised without a tag: the fields tell them apart).
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]

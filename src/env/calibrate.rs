@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use super::spec::{EnvSpec, Normalization};
 use super::LbmEnv;
-use crate::validate::case::Level;
+use crate::flow::Level;
 
 /// The committed table, as text (embedded at build time).
 pub const TABLE: &str = include_str!("../../benchmarks/envs/normalization.toml");

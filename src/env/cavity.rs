@@ -47,7 +47,7 @@
 
 use super::actuation::{Jet, Ramp};
 use super::spec::{probe_grid, ActuationSpec, EdgeName, EnvSpec, Normalization, RewardSpec, SpongeSpec};
-use crate::validate::case::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
+use crate::flow::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
 
 pub const REYNOLDS: [u32; 2] = [4200, 7500];
 

@@ -14,7 +14,7 @@
 
 use super::actuation::Ramp;
 use super::spec::{probe_grid, ActuationSpec, EnvSpec, Normalization, RewardSpec};
-use crate::validate::case::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
+use crate::flow::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
 
 /// The Reynolds numbers of the family.
 pub const REYNOLDS: [u32; 4] = [100, 200, 1000, 3900];

@@ -7,7 +7,7 @@
 use crate::data::field::Snapshot;
 use crate::env::any::AnyEnv;
 use crate::env::LbmEnv;
-use crate::validate::run::vorticity_field;
+use crate::flow::vorticity_field;
 
 /// An environment that can show its flow.
 pub trait FlowFields {

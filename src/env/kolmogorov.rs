@@ -29,7 +29,7 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
 use super::seeding::splitmix64;
-use crate::validate::case::{Level, ResolutionSpec};
+use crate::flow::{Level, ResolutionSpec};
 
 pub const REYNOLDS: [u32; 3] = [40, 100, 200];
 

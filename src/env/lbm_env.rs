@@ -21,13 +21,12 @@ use std::path::PathBuf;
 
 use hgym_agents::{checked_action, BoxSpace, Env, EnvError, Info, StepResult};
 use hgym_solvers::lbm::thermal::{Thermal, ThermalSide};
-use hgym_solvers::lbm::{D2q9, D2q9Config, Edge, Grid, LbmError, Side, Units};
+use hgym_solvers::lbm::{D2q9, Edge, LbmError, Side, Units};
 
 use super::actuation::{apply, Jet, WallMotion};
 use super::seeding::splitmix64;
 use super::spec::{ActuationSpec, EnvSpec, RewardSpec};
-use crate::validate::case::{GeometrySpec, Level};
-use crate::validate::run::{build_shape, sides_of};
+use crate::flow::{FlowError, GeometrySpec, Level, LbmFlow};
 
 pub struct LbmEnv {
     spec: EnvSpec,
@@ -65,50 +64,22 @@ fn backend(e: impl std::fmt::Display) -> EnvError {
 }
 
 impl LbmEnv {
-    /// Builds the solver for `spec` at `level`; `cache_dir` keeps developed-flow states between
-    /// processes (none: in memory only).
+    /// Builds the solver for `spec` at `level` through the flow layer (`EnvSpec::flow_setup`,
+    /// then `FlowSetup::check`, `plan` and `build`: the path validation runs); `cache_dir` keeps
+    /// developed-flow states between processes (none: in memory only).
     pub fn new(mut spec: EnvSpec, level: Level, cache_dir: Option<PathBuf>) -> Result<Self, EnvError> {
         // Level-specific statistics where the committed table has them (the spec carries the
         // default level's).
         if let Some(n) = super::calibrate::level_normalization(&spec, level) {
             spec.normalization = n;
         }
-        let n = spec.cells_per_length(level) as f64;
-        let units = Units {
-            cells_per_length: n,
-            u_lattice: spec.lattice_velocity,
-            reynolds: spec.reynolds,
-        };
-        let d = &spec.domain;
-        let dx = 1.0 / n;
-        let (nx, ny) = (((d.x[1] - d.x[0]) * n).round() as usize, ((d.y[1] - d.y[0]) * n).round() as usize);
-        let grid = Grid {
-            origin: [d.x[0] + 0.5 * dx, d.y[0] + 0.5 * dx],
-            dx,
-        };
-        let u = spec.lattice_velocity as f32;
-        let inlet: Vec<[f32; 2]> = if spec.inflow.is_some() {
-            // Poiseuille profile of mean U across the channel (the domain's height).
-            (0..ny)
-                .map(|j| {
-                    let eta = (j as f64 + 0.5) / ny as f64;
-                    [(6.0 * eta * (1.0 - eta)) as f32 * u, 0.0]
-                })
-                .collect()
-        } else {
-            vec![[u, 0.0]; ny]
-        };
-        let sides = sides_of(&spec.boundaries, &inlet);
-        let mut cfg = D2q9Config::new(nx, ny, units.tau(), sides);
-        cfg.collision = spec.collision;
-        cfg.smagorinsky = spec.smagorinsky;
-        cfg.grid = grid;
-        cfg.check_interval = 100;
-        if let Some(sp) = &spec.sponge {
-            cfg.sponges.push(sp.lattice(n, spec.lattice_velocity));
-        }
-        let bodies = spec.bodies.iter().map(build_shape).collect();
-        let solver = D2q9::new(cfg, bodies).map_err(backend)?;
+        let setup = spec.flow_setup();
+        let flow_error = |e: FlowError| EnvError::Backend(format!("{}: {e}", spec.id));
+        setup.check().map_err(flow_error)?;
+        let plan = setup.plan(level).map_err(flow_error)?;
+        let units = plan.units;
+        let (nx, ny) = (plan.nx, plan.ny);
+        let solver = setup.build(&plan).and_then(LbmFlow::into_uniform).map_err(flow_error)?;
         let thermal = match &spec.thermal {
             None => None,
             Some(th) => {
@@ -477,14 +448,12 @@ impl LbmEnv {
 }
 
 impl Env for LbmEnv {
-    /// Probe values; `[-5, 5]` once calibrated (3-sigma scaling), unbounded before.
+    /// Probe values, normalised by the calibrated statistics to about [-1, 1] for the
+    /// uncontrolled flow, and unbounded: actuation drives probes far outside the uncontrolled
+    /// range (JetPinball_2D_Re75 at coarse passes 5 scales under full blowing), so no finite
+    /// bound would be a promise the env keeps.
     fn observation_space(&self) -> BoxSpace {
-        let n = self.spec.obs_dim();
-        if self.spec.normalization.mean.len() == n {
-            BoxSpace::uniform(n, -5.0, 5.0)
-        } else {
-            BoxSpace::uniform(n, f64::NEG_INFINITY, f64::INFINITY)
-        }
+        BoxSpace::uniform(self.spec.obs_dim(), f64::NEG_INFINITY, f64::INFINITY)
     }
 
     fn action_space(&self) -> BoxSpace {
@@ -568,12 +537,18 @@ impl Env for LbmEnv {
             info.set(&format!("C_D_{b}"), cd[b]);
             info.set(&format!("C_L_{b}"), cl[b]);
         }
-        info.set("C_D", cd.iter().sum());
-        info.set("C_L", cl.iter().sum());
-        if let RewardSpec::ProbeTemperature { probe, .. } = &self.spec.reward {
-            let t = self.spec.probes.get(*probe).and_then(|p| self.temperature_at(*p));
-            info.set("T_target", t.unwrap_or(f64::NAN));
-        }
+        let forces = IntervalForces { c_d: cd, c_l: cl };
+        let (c_d, c_l) = forces.totals();
+        info.set("C_D", c_d);
+        info.set("C_L", c_l);
+        let probe_temperature = match &self.spec.reward {
+            RewardSpec::ProbeTemperature { probe, .. } => {
+                let t = self.spec.probes.get(*probe).and_then(|p| self.temperature_at(*p));
+                info.set("T_target", t.unwrap_or(f64::NAN));
+                t
+            }
+            _ => None,
+        };
         if let Some(reason) = diverged {
             self.live = false;
             info.set("diverged", 1.0);
@@ -588,7 +563,7 @@ impl Env for LbmEnv {
             });
         }
         let obs = self.observation()?;
-        let reward = reward(&self.spec.reward, &info, &obs, n_bodies);
+        let reward = reward(&self.spec.reward, &forces, &obs, probe_temperature);
         let truncated = self.actions_taken >= self.spec.episode_actions;
         if truncated {
             self.live = false;
@@ -603,34 +578,41 @@ impl Env for LbmEnv {
     }
 }
 
-/// The reward from the force coefficients in `info` and the (normalised) observation `obs` at the
-/// end of the interval, so it can be recomputed from what `step` returns.
-pub fn reward(spec: &RewardSpec, info: &Info, obs: &[f64], n_bodies: usize) -> f64 {
+/// Interval-averaged force coefficients of each body, `C = F / (rho U^2 L / 2)` (what `info`
+/// reports as `C_D_b`, `C_L_b` and their sums `C_D`, `C_L`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct IntervalForces {
+    pub c_d: Vec<f64>,
+    pub c_l: Vec<f64>,
+}
+
+impl IntervalForces {
+    /// Total drag and lift over the bodies.
+    pub fn totals(&self) -> (f64, f64) {
+        (self.c_d.iter().sum(), self.c_l.iter().sum())
+    }
+}
+
+/// The reward of one interval from its forces, the (normalised) observation `obs` at its end,
+/// and the temperature at the reward's probe (`ProbeTemperature` only, units of T_wall).
+pub fn reward(spec: &RewardSpec, forces: &IntervalForces, obs: &[f64], probe_temperature: Option<f64>) -> f64 {
+    let (c_d, c_l) = forces.totals();
     match spec {
         RewardSpec::DragLift { lift_weight } => {
             let mut r = 0.0;
-            for b in 0..n_bodies {
-                r -= info.get(&format!("C_D_{b}")).unwrap_or(0.0).abs();
-                r -= lift_weight * info.get(&format!("C_L_{b}")).unwrap_or(0.0).abs();
+            for (d, l) in forces.c_d.iter().zip(&forces.c_l) {
+                r -= d.abs();
+                r -= lift_weight * l.abs();
             }
             r
         }
-        RewardSpec::TotalDragLift { lift_weight } => {
-            // `C_D` and `C_L` in `info` are the sums over the bodies.
-            let c_d = info.get("C_D").unwrap_or(0.0);
-            let c_l = info.get("C_L").unwrap_or(0.0);
-            -c_d.abs() - lift_weight * c_l.abs()
-        }
+        RewardSpec::TotalDragLift { lift_weight } => -c_d.abs() - lift_weight * c_l.abs(),
         RewardSpec::ProbeDeviation => -9.0 * obs.iter().map(|o| o * o).sum::<f64>(),
-        RewardSpec::ProbeTemperature { target, weight, .. } => -weight * (info.get("T_target").unwrap_or(f64::NAN) - target).abs(),
+        RewardSpec::ProbeTemperature { target, weight, .. } => -weight * (probe_temperature.unwrap_or(f64::NAN) - target).abs(),
         RewardSpec::GustLoads {
             c_l_ref,
             c_d_ref,
             drag_weight,
-        } => {
-            let c_d = info.get("C_D").unwrap_or(0.0);
-            let c_l = info.get("C_L").unwrap_or(0.0);
-            -(c_l - c_l_ref).abs() - drag_weight * (c_d - c_d_ref).abs()
-        }
+        } => -(c_l - c_l_ref).abs() - drag_weight * (c_d - c_d_ref).abs(),
     }
 }

@@ -35,7 +35,7 @@ use hgym_solvers::geometry::Naca4;
 use super::actuation::Jet;
 use super::cylinder::bluff_body;
 use super::spec::{probe_grid, ActuationSpec, EnvSpec, GustSpec, RewardSpec};
-use crate::validate::case::{DomainSpec, GeometrySpec, ResolutionSpec};
+use crate::flow::{DomainSpec, GeometrySpec, ResolutionSpec};
 
 pub const REYNOLDS: [u32; 2] = [100, 1000];
 pub const ANGLES: [u32; 2] = [20, 40];

@@ -17,7 +17,7 @@
 
 use super::actuation::Ramp;
 use super::spec::{probe_grid, ActuationSpec, EnvSpec, Normalization, RewardSpec};
-use crate::validate::case::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
+use crate::flow::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
 
 pub const REYNOLDS: [u32; 4] = [30, 75, 100, 150];
 

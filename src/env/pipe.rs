@@ -48,7 +48,7 @@
 
 use super::actuation::Ramp;
 use super::spec::{ActuationSpec, EnvSpec, InflowSpec, Normalization, RewardSpec, ThermalSpec};
-use crate::validate::case::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
+use crate::flow::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec};
 
 pub const REYNOLDS: [u32; 1] = [100];
 

@@ -10,8 +10,8 @@ use sha2::{Digest, Sha256};
 use hgym_solvers::lbm::Collision;
 
 use super::actuation::{Jet, Ramp};
-use crate::validate::case::{BoundarySpec, DomainSpec, GeometrySpec, Level, ResolutionSpec};
-pub use crate::validate::case::{EdgeName, SpongeSpec};
+use crate::flow::{BoundarySpec, DomainSpec, FlowSetup, GeometrySpec, InletSpec, Level, Profile, ResolutionSpec, VelocityReference};
+pub use crate::flow::{EdgeName, SpongeSpec};
 
 /// The actuators of an environment; actions in `[-1, 1]` are scaled by the bound given here.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -204,10 +204,45 @@ impl EnvSpec {
     }
 
     pub fn cells_per_length(&self, level: Level) -> u32 {
-        match level {
-            Level::Coarse => self.resolution.coarse,
-            Level::Default => self.resolution.default,
-            Level::Fine => self.resolution.fine,
+        self.resolution.at(level)
+    }
+
+    /// The bundled validation case whose literature references this environment's uncontrolled
+    /// flow is compared with (`hgym validate --env ID`), by family and Reynolds number, e.g.
+    /// `cylinder_re100`; none for families without 2D references here (cavity, aerofoil, pipe).
+    pub fn validation_case(&self) -> Option<String> {
+        let base = match self.family.as_str() {
+            "cylinder" | "rotary_cylinder" => "cylinder",
+            "pinball" | "jet_pinball" => "pinball",
+            "square_cylinder" => "square",
+            _ => return None,
+        };
+        Some(format!("{base}_re{}", self.reynolds.round() as i64))
+    }
+
+    /// The flow this environment runs (what `FlowSetup::build` makes its solver from): a
+    /// uniform inlet, or with `inflow` a Poiseuille profile of mean U whose scale oscillates.
+    pub fn flow_setup(&self) -> FlowSetup {
+        let inlet = match &self.inflow {
+            None => InletSpec::default(),
+            Some(_) => InletSpec {
+                profile: Profile::Parabolic,
+                reference_velocity: VelocityReference::Mean,
+                ..InletSpec::default()
+            },
+        };
+        FlowSetup {
+            bodies: self.bodies.clone(),
+            domain: self.domain.clone(),
+            boundaries: self.boundaries.clone(),
+            inlet,
+            reynolds: self.reynolds,
+            lattice_velocity: self.lattice_velocity,
+            collision: self.collision,
+            smagorinsky: self.smagorinsky,
+            resolution: self.resolution.clone(),
+            sponges: self.sponge.iter().map(|s| (**s).clone()).collect(),
+            refinement: None,
         }
     }
 

@@ -18,7 +18,7 @@
 use super::actuation::Jet;
 use super::cylinder::bluff_body;
 use super::spec::{ActuationSpec, EnvSpec};
-use crate::validate::case::GeometrySpec;
+use crate::flow::GeometrySpec;
 
 pub const REYNOLDS: [u32; 3] = [200, 1000, 3900];
 
@@ -77,7 +77,7 @@ pub fn square(re: u32) -> EnvSpec {
 mod tests {
     use super::*;
     use crate::env::LbmEnv;
-    use crate::validate::case::Level;
+    use crate::flow::Level;
 
     /// On the env's own grid at every level, each of the four jets reaches wall links: blowing
     /// injects mass, suction removes the same amount, and the mirror pairs (upper/lower) inject

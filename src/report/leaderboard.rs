@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::report::plots;
-use crate::train::eval::{EvalReport, Stat};
+use crate::report::eval::{EvalReport, Stat};
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Entry {

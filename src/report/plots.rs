@@ -180,6 +180,14 @@ fn diverging(v: f64) -> RGBColor {
     }
 }
 
+/// Writes `f` as a PNG colour map titled `label`, with a symmetric colour range at the 98th
+/// percentile of |value| (so a few extremes do not wash out the rest).
+pub fn field_png(f: &crate::flow::Field, path: &Path, label: &str) -> Result<(), String> {
+    let vmax = abs_quantile(&f.values, 0.98);
+    let title = format!("{label} (colour range +-{vmax:.2})");
+    field(path, &title, f.nx, f.ny, f.extent, &f.values, vmax)
+}
+
 /// Colour map of a field on `[x0, x1] x [y0, y1]` (row-major, `NaN` drawn grey), symmetric
 /// colour range `+-vmax`.
 pub fn field(path: &Path, title: &str, nx: usize, ny: usize, extent: [f64; 4], values: &[f32], vmax: f64) -> Result<(), String> {

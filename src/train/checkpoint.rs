@@ -9,7 +9,7 @@ use hgym_agents::learn::Algo;
 use serde::{Deserialize, Serialize};
 
 use super::curve::CurveRow;
-use crate::validate::case::Level;
+use crate::flow::Level;
 
 pub const FORMAT: u32 = 1;
 pub const FILE: &str = "checkpoint.bin";

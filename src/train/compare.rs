@@ -18,7 +18,7 @@ use super::config::TrainConfig;
 use super::curve::{from_csv, CurveRow};
 use super::eval::{evaluate, Stat};
 use crate::report::plots;
-use crate::validate::case::Level;
+use crate::flow::Level;
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]

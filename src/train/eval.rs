@@ -10,79 +10,9 @@ use hgym_agents::rollout::{episode, EpisodeAccumulator, EpisodeStats};
 
 use crate::data::trajectory::TrajectoryWriter;
 use hgym_agents::{Env, EnvError};
-use serde::{Deserialize, Serialize};
 
-/// JSON has no NaN: serde_json writes it as `null`; read `null` back as NaN.
-pub fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
-}
 
-/// Mean and sample standard deviation.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Stat {
-    #[serde(deserialize_with = "nan_if_null")]
-    pub mean: f64,
-    #[serde(deserialize_with = "nan_if_null")]
-    pub std: f64,
-}
-
-impl Stat {
-    pub fn of(v: &[f64]) -> Stat {
-        let n = v.len();
-        if n == 0 {
-            return Stat {
-                mean: f64::NAN,
-                std: f64::NAN,
-            };
-        }
-        let mean = v.iter().sum::<f64>() / n as f64;
-        let std = if n > 1 {
-            (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt()
-        } else {
-            0.0
-        };
-        Stat { mean, std }
-    }
-}
-
-/// One evaluation episode.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct EvalEpisode {
-    pub seed: u64,
-    #[serde(deserialize_with = "nan_if_null")]
-    pub ret: f64,
-    pub length: usize,
-    pub terminated: bool,
-    #[serde(deserialize_with = "nan_if_null")]
-    pub mean_c_d: f64,
-    /// Mean C_D of the uncontrolled flow from the same initial state.
-    #[serde(deserialize_with = "nan_if_null")]
-    pub uncontrolled_c_d: f64,
-    /// `100 (1 - C_D / C_D,uncontrolled)`.
-    #[serde(deserialize_with = "nan_if_null")]
-    pub drag_reduction_pct: f64,
-    #[serde(deserialize_with = "nan_if_null")]
-    pub mean_abs_c_l: f64,
-    /// Mean over steps of the sum of squared normalised actions.
-    #[serde(deserialize_with = "nan_if_null")]
-    pub actuation_cost: f64,
-}
-
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct EvalReport {
-    pub schema: String,
-    pub env_id: String,
-    pub spec_hash: String,
-    pub level: String,
-    pub policy: String,
-    pub episodes: Vec<EvalEpisode>,
-    pub ret: Stat,
-    pub mean_c_d: Stat,
-    pub uncontrolled_c_d: Stat,
-    pub drag_reduction_pct: Stat,
-    pub mean_abs_c_l: Stat,
-    pub actuation_cost: Stat,
-}
+pub use crate::report::eval::{nan_if_null, EvalEpisode, EvalReport, Stat};
 
 /// The mean C_D of each uncontrolled episode from `reset(seed)` for `seeds`.
 pub fn uncontrolled_c_d<E: Env + ?Sized>(env: &mut E, seeds: &[u64]) -> Result<Vec<f64>, EnvError> {

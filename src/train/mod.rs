@@ -30,7 +30,7 @@ use self::curve::CurveRow;
 use self::eval::{evaluate, uncontrolled_c_d, EvalReport, Stat};
 use crate::env::any::{AnyEnv, AnySpec};
 use crate::report::manifest::{manifest, Manifest};
-use crate::validate::case::Level;
+use crate::flow::Level;
 
 #[derive(Debug, thiserror::Error)]
 pub enum TrainError {

@@ -13,6 +13,12 @@ use sha2::{Digest, Sha256};
 
 use hgym_solvers::lbm::Collision;
 
+pub use crate::flow::{
+    BoundaryKind, BoundarySpec, DomainSpec, EdgeName, GeometrySpec, InletSpec, Level, Profile, RefinementSpec, ResolutionSpec, SpongeSpec,
+    VelocityReference, MAX_LATTICE_SPEED, MAX_NODES,
+};
+use crate::flow::{FlowError, FlowSetup};
+
 use super::ValidateError;
 
 /// The cases shipped inside the binary: `(file name, text)`.
@@ -39,12 +45,6 @@ pub const BUNDLED: &[(&str, &str)] = &[
     ("square_re200.toml", include_str!("../../benchmarks/validation/square_re200.toml")),
     ("square_re1000.toml", include_str!("../../benchmarks/validation/square_re1000.toml")),
 ];
-
-/// Largest lattice speed anywhere on the inlet (Mach 0.3 = 0.173 lattice units): above it the
-/// compressibility error of the LBM exceeds a few percent.
-pub const MAX_LATTICE_SPEED: f64 = 0.173;
-/// Largest grid accepted (nodes), about 3.6 GB of populations.
-pub const MAX_NODES: usize = 50_000_000;
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -77,64 +77,6 @@ pub struct Case {
     pub reference: Vec<ReferenceSpec>,
 }
 
-/// Nested refined rectangles `[x0, x1, y0, y1]` (case length units), coarsest first: inside the
-/// first the grid is twice as fine as the level's (`cells_per_length` applies outside), inside
-/// the second four times, and so on. Each lies inside the one before; the last contains every
-/// body with some room; the first stays clear of the domain's edges and absorbing layers.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct RefinementSpec {
-    pub regions: Vec<[f64; 4]>,
-}
-
-/// An edge of the rectangular domain, by compass direction.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
-#[serde(rename_all = "snake_case")]
-pub enum EdgeName {
-    West,
-    East,
-    South,
-    North,
-}
-
-impl EdgeName {
-    pub fn lattice(self) -> hgym_solvers::lbm::Edge {
-        use hgym_solvers::lbm::Edge;
-        match self {
-            EdgeName::West => Edge::West,
-            EdgeName::East => Edge::East,
-            EdgeName::South => Edge::South,
-            EdgeName::North => Edge::North,
-        }
-    }
-}
-
-/// An absorbing layer (see `hgym_solvers::lbm::sponge`): `thickness` in reference lengths,
-/// `strength` the relaxation per lattice step at the edge (the ramp is quadratic), target the
-/// free stream `(rho, u) = (1, U)`. Used by environment specs (`sponge`) and validation cases
-/// (`[[sponge]]`).
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct SpongeSpec {
-    pub edge: EdgeName,
-    pub thickness: f64,
-    pub strength: f64,
-}
-
-impl SpongeSpec {
-    /// The solver's layer at `cells_per_length` cells per reference length, free stream at lattice
-    /// speed `u`: at least one node thick.
-    pub fn lattice(&self, cells_per_length: f64, u: f64) -> hgym_solvers::lbm::Sponge {
-        hgym_solvers::lbm::Sponge {
-            edge: self.edge.lattice(),
-            width: ((self.thickness * cells_per_length).round() as usize).max(1),
-            strength: self.strength,
-            rho: 1.0,
-            u: [u, 0.0],
-        }
-    }
-}
-
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct CaseInfo {
@@ -142,141 +84,6 @@ pub struct CaseInfo {
     pub family: String,
     #[serde(default)]
     pub description: String,
-}
-
-/// The body. Its reference length (for Re, coefficients and resolution) is the diameter, the
-/// side, or the chord.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(tag = "shape", rename_all = "lowercase", deny_unknown_fields)]
-pub enum GeometrySpec {
-    Circle {
-        center: [f64; 2],
-        diameter: f64,
-    },
-    Square {
-        center: [f64; 2],
-        side: f64,
-    },
-    Naca {
-        digits: String,
-        chord: f64,
-        leading_edge: [f64; 2],
-        aoa_deg: f64,
-    },
-    /// An open cavity cut into a flat wall `y = leading_edge[1]` (the plate upstream and
-    /// downstream of it is solid down to the domain's bottom); reference length: the depth.
-    Cavity {
-        leading_edge: [f64; 2],
-        length: f64,
-        depth: f64,
-    },
-    /// A cosine constriction of a straight channel (the domain's walls) with its throat at
-    /// `center`; reference length: the channel width.
-    Stenosis {
-        center: [f64; 2],
-        width: f64,
-        length: f64,
-        severity: f64,
-    },
-}
-
-impl GeometrySpec {
-    pub fn reference_length(&self) -> f64 {
-        match self {
-            GeometrySpec::Circle { diameter, .. } => *diameter,
-            GeometrySpec::Square { side, .. } => *side,
-            GeometrySpec::Naca { chord, .. } => *chord,
-            GeometrySpec::Cavity { depth, .. } => *depth,
-            GeometrySpec::Stenosis { width, .. } => *width,
-        }
-    }
-
-    /// Whether fluid at `p` starts at rest when a flow is spun up from the uniform stream: below
-    /// a cavity's lips (an impulsive start with U inside the cavity sheds vortices that the thin
-    /// layer above it keeps for tens of time units); everywhere in a stenosed channel (its
-    /// oscillatory inflow starts from zero); nowhere for the other shapes.
-    pub fn starts_at_rest(&self, p: [f64; 2]) -> bool {
-        match self {
-            GeometrySpec::Cavity { leading_edge, .. } => p[1] < leading_edge[1],
-            GeometrySpec::Stenosis { .. } => true,
-            _ => false,
-        }
-    }
-
-    /// A point at the body's centre (for the initial perturbation).
-    pub fn center(&self) -> [f64; 2] {
-        match self {
-            GeometrySpec::Circle { center, .. } | GeometrySpec::Square { center, .. } | GeometrySpec::Stenosis { center, .. } => *center,
-            GeometrySpec::Naca { chord, leading_edge, .. } => [leading_edge[0] + 0.5 * chord, leading_edge[1]],
-            GeometrySpec::Cavity {
-                leading_edge,
-                length,
-                depth,
-            } => [leading_edge[0] + 0.5 * length, leading_edge[1] - 0.5 * depth],
-        }
-    }
-}
-
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct DomainSpec {
-    pub x: [f64; 2],
-    pub y: [f64; 2],
-}
-
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq)]
-#[serde(rename_all = "kebab-case")]
-pub enum BoundaryKind {
-    Inlet,
-    Outlet,
-    Periodic,
-    Wall,
-    FreeSlip,
-}
-
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct BoundarySpec {
-    pub west: BoundaryKind,
-    pub east: BoundaryKind,
-    pub south: BoundaryKind,
-    pub north: BoundaryKind,
-}
-
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum Profile {
-    #[default]
-    Uniform,
-    /// `u(y) = u_max 4 (y - y0)(y1 - y) / (y1 - y0)^2` across the whole domain height.
-    Parabolic,
-}
-
-/// Which inlet velocity U is (for Re and the coefficients) when the profile is parabolic.
-#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq, Eq, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum VelocityReference {
-    #[default]
-    Mean,
-    Max,
-}
-
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq, Default)]
-#[serde(deny_unknown_fields)]
-pub struct InletSpec {
-    #[serde(default)]
-    pub profile: Profile,
-    #[serde(default)]
-    pub reference_velocity: VelocityReference,
-    /// Smooth ramp of the inlet from 0 to full speed over this time (0: impulsive start).
-    #[serde(default)]
-    pub ramp: f64,
-    /// Non-reflecting (characteristic) inlet: the inflow's normal velocity follows outgoing
-    /// pressure waves, `u_n = U - c_s (rho - rho_ref)`, with `rho_ref` the inlet's mean density
-    /// averaged over this time (L/U); 0 (the default) keeps the rigid velocity inlet, which
-    /// reflects them. See `hgym_solvers::lbm::boundary::InletReference`.
-    #[serde(default)]
-    pub characteristic_time: f64,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -297,14 +104,6 @@ pub struct FlowSpec {
     /// value is the mirror image of the positive one (it selects the other of two mirror states).
     #[serde(default)]
     pub perturbation: f64,
-}
-
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct ResolutionSpec {
-    pub coarse: u32,
-    pub default: u32,
-    pub fine: u32,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -402,22 +201,75 @@ pub struct ReferenceSpec {
     pub source: String,
 }
 
-/// Resolution level: a number of cells per reference length, never a different case.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum Level {
-    Coarse,
-    Default,
-    Fine,
+impl Case {
+    /// The flow this case runs: `[geometry]` and `[[more_bodies]]` in order, then the set-up's
+    /// tables, with `[flow]`'s Reynolds number, lattice velocity, collision and subgrid model.
+    pub fn flow_setup(&self) -> FlowSetup {
+        FlowSetup {
+            bodies: std::iter::once(&self.geometry).chain(&self.more_bodies).cloned().collect(),
+            domain: self.domain.clone(),
+            boundaries: self.boundaries.clone(),
+            inlet: self.inlet.clone(),
+            reynolds: self.flow.reynolds,
+            lattice_velocity: self.flow.lattice_velocity,
+            collision: self.flow.collision,
+            smagorinsky: self.flow.smagorinsky,
+            resolution: self.resolution.clone(),
+            sponges: self.sponge.clone(),
+            refinement: self.refinement.clone(),
+        }
+    }
 }
 
-impl Level {
-    pub fn name(self) -> &'static str {
-        match self {
-            Level::Coarse => "coarse",
-            Level::Default => "default",
-            Level::Fine => "fine",
+impl LoadedCase {
+    /// This case's quantities, references, times and initial kick on another flow (an
+    /// environment's own domain and grid), named `name`; `origin` says where the flow came from.
+    /// The hash is that of the new case's JSON form.
+    pub fn on_flow(&self, setup: &FlowSetup, name: &str, description: &str, origin: &str) -> Result<LoadedCase, ValidateError> {
+        let mut bodies = setup.bodies.iter().cloned();
+        let geometry = bodies.next().ok_or_else(|| bad(name, "geometry", "the flow has no body"))?;
+        let mut case = self.case.clone();
+        case.case.name = name.to_string();
+        case.case.description = description.to_string();
+        case.geometry = geometry;
+        case.more_bodies = bodies.collect();
+        case.domain = setup.domain.clone();
+        case.boundaries = setup.boundaries.clone();
+        case.inlet = setup.inlet.clone();
+        case.flow.reynolds = setup.reynolds;
+        case.flow.lattice_velocity = setup.lattice_velocity;
+        case.flow.collision = setup.collision;
+        case.flow.smagorinsky = setup.smagorinsky;
+        case.resolution = setup.resolution.clone();
+        case.sponge = setup.sponges.clone();
+        case.refinement = setup.refinement.clone();
+        let json = serde_json::to_string(&case).map_err(|e| bad(name, "case", e.to_string()))?;
+        let loaded = LoadedCase {
+            case,
+            origin: origin.to_string(),
+            hash: format!("{:x}", Sha256::digest(json.as_bytes())),
+        };
+        loaded.check_static()?;
+        Ok(loaded)
+    }
+}
+
+/// A set-up error as a case error, naming the field as the case file spells it.
+pub(crate) fn flow_error(case: &str, e: FlowError) -> ValidateError {
+    match e {
+        FlowError::Invalid { field, message } => {
+            let field = match field {
+                "reynolds" | "lattice_velocity" | "smagorinsky" => format!("flow.{field}"),
+                "bodies" => "geometry".to_string(),
+                other => other.to_string(),
+            };
+            ValidateError::Unrunnable {
+                case: case.to_string(),
+                field,
+                message,
+            }
         }
+        FlowError::Solver(source) => ValidateError::Solver(source.to_string()),
     }
 }
 
@@ -467,120 +319,9 @@ impl LoadedCase {
                 "use letters, digits, '_' and '-' only (it names the output files)",
             ));
         }
-        let f = &c.flow;
-        if !(f.reynolds.is_finite() && f.reynolds > 0.0) {
-            return Err(bad(name, "flow.reynolds", format!("must be a positive number, got {}", f.reynolds)));
-        }
-        if !(f.lattice_velocity.is_finite() && f.lattice_velocity > 0.0) {
-            return Err(bad(
-                name,
-                "flow.lattice_velocity",
-                format!("must be positive, got {}", f.lattice_velocity),
-            ));
-        }
-        let peak = f.lattice_velocity * self.inlet_peak_factor();
-        if peak > MAX_LATTICE_SPEED {
-            return Err(bad(
-                name,
-                "flow.lattice_velocity",
-                format!(
-                    "the inlet reaches lattice speed {peak:.3} (Mach {:.2}); the limit is {MAX_LATTICE_SPEED} (Mach 0.3): \
-                     lower lattice_velocity to at most {:.3}",
-                    peak * 3f64.sqrt(),
-                    MAX_LATTICE_SPEED / self.inlet_peak_factor()
-                ),
-            ));
-        }
-        if !(f.perturbation.is_finite() && f.perturbation.abs() <= 1.0) {
+        c.flow_setup().check().map_err(|e| flow_error(name, e))?;
+        if !(c.flow.perturbation.is_finite() && c.flow.perturbation.abs() <= 1.0) {
             return Err(bad(name, "flow.perturbation", "must be between -1 and 1 (a fraction of U)"));
-        }
-        let d = &c.domain;
-        if !(d.x[1] > d.x[0] && d.y[1] > d.y[0]) || d.x.iter().chain(&d.y).any(|v| !v.is_finite()) {
-            return Err(bad(name, "domain", "x and y must be finite [min, max] pairs with min < max"));
-        }
-        let l = c.geometry.reference_length();
-        if !(l.is_finite() && l > 0.0) {
-            return Err(bad(
-                name,
-                "geometry",
-                format!("the reference length (diameter, side or chord) must be positive, got {l}"),
-            ));
-        }
-        if let GeometrySpec::Naca { digits, .. } = &c.geometry {
-            if hgym_solvers::geometry::Naca4::from_digits(digits, 1.0, [0.0, 0.0], 0.0).is_none() {
-                return Err(bad(
-                    name,
-                    "geometry.digits",
-                    format!("'{digits}' is not a NACA 4-digit code (e.g. \"0012\")"),
-                ));
-            }
-        }
-        let r = &c.resolution;
-        for (lvl, n) in [("coarse", r.coarse), ("default", r.default), ("fine", r.fine)] {
-            if n < 4 {
-                return Err(bad(
-                    name,
-                    "resolution",
-                    format!("{lvl} = {n} cells per length is too few (at least 4)"),
-                ));
-            }
-        }
-        let b = &c.boundaries;
-        if (b.west == BoundaryKind::Periodic) != (b.east == BoundaryKind::Periodic) {
-            return Err(bad(name, "boundaries", "west and east must both be periodic or neither"));
-        }
-        if (b.south == BoundaryKind::Periodic) != (b.north == BoundaryKind::Periodic) {
-            return Err(bad(name, "boundaries", "south and north must both be periodic or neither"));
-        }
-        for (side, kind) in [("east", b.east), ("south", b.south), ("north", b.north)] {
-            if kind == BoundaryKind::Inlet {
-                return Err(bad(
-                    name,
-                    "boundaries",
-                    format!("{side} = \"inlet\": only the west side can be an inlet (flow in +x)"),
-                ));
-            }
-        }
-        if c.inlet.ramp < 0.0 || !c.inlet.ramp.is_finite() {
-            return Err(bad(name, "inlet.ramp", "must be zero or a positive time"));
-        }
-        if c.inlet.characteristic_time < 0.0 || !c.inlet.characteristic_time.is_finite() {
-            return Err(bad(
-                name,
-                "inlet.characteristic_time",
-                "must be zero (a rigid inlet) or a positive time in L/U, e.g. 20",
-            ));
-        }
-        for (i, sp) in c.sponge.iter().enumerate() {
-            if c.sponge[..i].iter().any(|o| o.edge == sp.edge) {
-                return Err(bad(
-                    name,
-                    "sponge",
-                    format!("two layers on the {:?} edge; give one per edge", sp.edge),
-                ));
-            }
-            if !(sp.thickness.is_finite() && sp.thickness > 0.0) {
-                return Err(bad(
-                    name,
-                    "sponge.thickness",
-                    format!("must be a positive length, got {}", sp.thickness),
-                ));
-            }
-            if !(sp.strength.is_finite() && sp.strength > 0.0 && sp.strength <= 1.0) {
-                return Err(bad(
-                    name,
-                    "sponge.strength",
-                    format!("the relaxation per step at the edge must be in (0, 1], got {}", sp.strength),
-                ));
-            }
-            if c.inlet.ramp > 0.0 {
-                return Err(bad(
-                    name,
-                    "sponge",
-                    "a layer relaxes to the full free stream, which a ramped inlet only reaches at the end of its ramp: \
-                     use one or the other",
-                ));
-            }
         }
         let t = &c.time;
         if !(t.spin_up.is_finite() && t.spin_up >= 0.0 && t.average.is_finite() && t.average > 0.0) {
@@ -630,87 +371,11 @@ impl LoadedCase {
                 }
             }
         }
-        if let Some(rf) = &c.refinement {
-            if rf.regions.is_empty() {
-                return Err(bad(name, "refinement.regions", "list at least one region [x0, x1, y0, y1]"));
-            }
-            let mut outer = [d.x[0], d.x[1], d.y[0], d.y[1]];
-            for (k, region) in rf.regions.iter().enumerate() {
-                let [x0, x1, y0, y1] = *region;
-                if !(region.iter().all(|v| v.is_finite()) && x0 < x1 && y0 < y1) {
-                    return Err(bad(
-                        name,
-                        "refinement.regions",
-                        format!("region {} must be [x0, x1, y0, y1] with x0 < x1 and y0 < y1, got {region:?}", k + 1),
-                    ));
-                }
-                if x0 <= outer[0] || x1 >= outer[1] || y0 <= outer[2] || y1 >= outer[3] {
-                    return Err(bad(
-                        name,
-                        "refinement.regions",
-                        format!(
-                            "region {} {region:?} must lie inside {} {outer:?} with room to spare",
-                            k + 1,
-                            if k == 0 { "the domain".to_string() } else { format!("region {k}") }
-                        ),
-                    ));
-                }
-                outer = *region;
-            }
-        }
-        // Bodies inside the domain, at least two cells from every edge even at the coarse level.
-        let dx = l / r.coarse.min(r.default).min(r.fine) as f64;
-        for g in std::iter::once(&c.geometry).chain(&c.more_bodies) {
-            let body = super::run::build_shape(g);
-            let bb = body.bounding_box();
-            if bb[0] < d.x[0] + 2.0 * dx || bb[2] > d.x[1] - 2.0 * dx || bb[1] < d.y[0] + 2.0 * dx || bb[3] > d.y[1] - 2.0 * dx {
-                return Err(bad(
-                    name,
-                    "geometry",
-                    format!(
-                        "the body spans [{:.3}, {:.3}] x [{:.3}, {:.3}], which does not fit inside the domain [{}, {}] x [{}, {}] \
-                     with two cells to spare: enlarge the domain or move/shrink the body",
-                        bb[0], bb[2], bb[1], bb[3], d.x[0], d.x[1], d.y[0], d.y[1]
-                    ),
-                ));
-            }
-            for sp in &c.sponge {
-                let inside = match sp.edge {
-                    EdgeName::West => bb[0] < d.x[0] + sp.thickness,
-                    EdgeName::East => bb[2] > d.x[1] - sp.thickness,
-                    EdgeName::South => bb[1] < d.y[0] + sp.thickness,
-                    EdgeName::North => bb[3] > d.y[1] - sp.thickness,
-                };
-                if inside {
-                    return Err(bad(
-                        name,
-                        "sponge.thickness",
-                        format!(
-                            "the {:?} layer ({} thick) reaches a body; make it thinner or the domain larger",
-                            sp.edge, sp.thickness
-                        ),
-                    ));
-                }
-            }
-        }
         Ok(())
     }
 
-    /// Peak inlet speed over U.
-    pub fn inlet_peak_factor(&self) -> f64 {
-        match (self.case.inlet.profile, self.case.inlet.reference_velocity) {
-            (Profile::Parabolic, VelocityReference::Mean) => 1.5,
-            _ => 1.0,
-        }
-    }
-
     pub fn cells_per_length(&self, level: Level) -> u32 {
-        let r = &self.case.resolution;
-        match level {
-            Level::Coarse => r.coarse,
-            Level::Default => r.default,
-            Level::Fine => r.fine,
-        }
+        self.case.resolution.at(level)
     }
 }
 

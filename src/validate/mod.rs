@@ -10,7 +10,6 @@
 
 pub mod analysis;
 pub mod case;
-pub mod kolmogorov;
 pub mod report;
 pub mod run;
 pub mod series;
@@ -24,7 +23,7 @@ pub use report::{Status, ValidationReport};
 
 #[derive(Debug, Error)]
 pub enum ValidateError {
-    #[error("unknown validation family '{family}'; the bundled families are: {}. Or run a case file with --case FILE", known.join(", "))]
+    #[error("unknown validation family or case '{family}'; the bundled families are: {} (`hgym validate --list` shows their cases). Or run a case file with --case FILE", known.join(", "))]
     UnknownFamily { family: String, known: Vec<String> },
     #[error("cannot read case file {path}: {message}")]
     CaseRead { path: String, message: String },
@@ -51,9 +50,13 @@ impl ValidateError {
     }
 }
 
-/// The bundled cases of one family (e.g. "cylinder").
+/// The bundled cases of one family (e.g. "cylinder"), or the bundled case of that name (e.g.
+/// "cylinder_re100").
 pub fn family_cases(family: &str) -> Result<Vec<LoadedCase>, ValidateError> {
-    let cases: Vec<LoadedCase> = bundled()?.into_iter().filter(|c| c.case.case.family == family).collect();
+    let cases: Vec<LoadedCase> = bundled()?
+        .into_iter()
+        .filter(|c| c.case.case.family == family || c.case.case.name == family)
+        .collect();
     if cases.is_empty() {
         return Err(ValidateError::UnknownFamily {
             family: family.to_string(),

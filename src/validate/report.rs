@@ -230,24 +230,24 @@ impl ValidationReport {
             description: case.case.description.clone(),
             origin: c.origin.clone(),
             case_hash: c.hash.clone(),
-            level: p.level.name().into(),
+            level: p.flow.level.name().into(),
             status,
             message,
             parameters: Parameters {
                 reynolds: case.flow.reynolds,
-                cells_per_length: p.units.cells_per_length,
-                lattice_velocity: p.units.u_lattice,
-                tau: p.tau,
-                mach: p.mach,
-                nx: p.nx,
-                ny: p.ny,
-                collision: p.collision.name().into(),
+                cells_per_length: p.flow.units.cells_per_length,
+                lattice_velocity: p.flow.units.u_lattice,
+                tau: p.flow.tau,
+                mach: p.flow.mach,
+                nx: p.flow.nx,
+                ny: p.flow.ny,
+                collision: p.flow.collision.name().into(),
                 spin_up: case.time.spin_up,
                 average: case.time.average,
                 steps_planned: p.total_steps,
                 steps_run: out.steps,
                 mlups: out.mlups,
-                refinement: p.refinement.as_ref().map(|r| RefinementParams {
+                refinement: p.flow.refinement.as_ref().map(|r| RefinementParams {
                     patches: r.patches.iter().map(|p| [p.x[0], p.x[1], p.y[0], p.y[1]]).collect(),
                     cells_per_length: r.cells_per_length,
                     tau: r.tau,
@@ -441,7 +441,7 @@ pub fn write_plots(r: &ValidationReport, out: &RunOutput, dir: &Path) -> Result<
         &marks,
     )?;
     let t_end = out.t.last().copied().unwrap_or(0.0);
-    out.vorticity.write_png(
+    plots::field_png(&out.vorticity, 
         &dir.join("vorticity.png"),
         &format!("{}: vorticity w L/U at t = {t_end:.1}", r.case),
     )?;
@@ -455,7 +455,8 @@ mod tests {
     /// The bundled square Re 200 case's report (spin-up 60 L/U) for a synthetic force history
     /// sampled every 0.01 L/U up to 220 L/U: drag 1.46, lift `sin(2 pi phase(t))`.
     fn synthetic_report(phase: &dyn Fn(f64) -> f64) -> ValidationReport {
-        use crate::validate::run::{Field, RunStatus};
+        use crate::flow::Field;
+        use crate::validate::run::RunStatus;
         let c = crate::validate::bundled()
             .unwrap()
             .into_iter()

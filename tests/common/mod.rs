@@ -39,3 +39,18 @@ pub fn read_mcap(file: &Path) -> Result<serde_json::Value, String> {
     }
     serde_json::from_slice(&o.stdout).map_err(|e| e.to_string())
 }
+
+/// Every file below `dir` (recursively, in directory order) whose path `keep` accepts.
+pub fn files_under(dir: &Path, keep: &dyn Fn(&Path) -> bool) -> Vec<PathBuf> {
+    let mut out = vec![];
+    let Ok(entries) = std::fs::read_dir(dir) else { return out };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            out.extend(files_under(&p, keep));
+        } else if keep(&p) {
+            out.push(p);
+        }
+    }
+    out
+}

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::env::kolmogorov::{spec, KolmogorovEnv};
 use crate::report::plots;
-use crate::validate::case::Level;
+use crate::flow::Level;
 use hgym_agents::{Env, EnvError};
 
 /// The committed case file.

@@ -1,0 +1,197 @@
+//! `hgym validate`: bundled cases of a family (`hgym validate cylinder`), case files
+//! (`--case FILE`), or environments' own uncontrolled flows (`--env ID`, see `hgym::fidelity`).
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+
+use super::progress::Progress;
+use crate::{thread_pool, Outcome, UsageError};
+use hgym::fidelity::{self, Entry};
+use hgym::flow::Level;
+use hgym::validate::{self, LoadedCase, Options, Status, ValidationReport};
+
+#[derive(Args)]
+pub struct ValidateArgs {
+    /// Families of bundled cases (e.g. `cylinder`) or bundled cases by name (e.g.
+    /// `cylinder_re100`) to run; omit them with --case, --env or --list.
+    names: Vec<String>,
+    /// Case file(s) to run instead of a bundled family (repeatable).
+    #[arg(long = "case", value_name = "FILE")]
+    cases: Vec<PathBuf>,
+    /// Environment ID(s) whose own uncontrolled flow (its domain, its grid at --level) to compare
+    /// with its family's literature references (repeatable); `all` runs every ID that has them,
+    /// each distinct flow once. Reports go to `<out>/envs/<ID>-<level>.json`.
+    #[arg(long = "env", value_name = "ID")]
+    envs: Vec<String>,
+    /// With --env: record the deviations in the table `hgym envs` shows.
+    #[arg(long)]
+    record: bool,
+    /// The table --record writes (rebuild to embed it).
+    #[arg(long, default_value = "benchmarks/envs/fidelity.toml")]
+    table: PathBuf,
+    /// Resolution level (cells per reference length as given in each case file or spec).
+    #[arg(long, value_enum, default_value_t = Level::Default)]
+    level: Level,
+    /// Output folder for `<case>.json` and `<case>/*.png`.
+    #[arg(long, default_value = "results/validation")]
+    out: PathBuf,
+    /// Worker threads (default: all cores). Results are bitwise identical for any count.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Print the reports as a JSON array on stdout instead of tables.
+    #[arg(long)]
+    json: bool,
+    /// List the bundled cases and exit.
+    #[arg(long)]
+    list: bool,
+}
+
+/// `hgym validate`: bundled cases of a family, case files, or environments' own flows.
+pub fn run(args: ValidateArgs) -> Result<Outcome> {
+    if !args.envs.is_empty() {
+        if !args.names.is_empty() || !args.cases.is_empty() {
+            return Err(UsageError("give a family, --case FILE or --env ID, one of them".into()).into());
+        }
+        return run_envs(&args);
+    }
+    if args.record {
+        return Err(UsageError("--record writes the environments' table: use it with --env ID".into()).into());
+    }
+    if args.names == ["kolmogorov"] {
+        let (pool, _) = thread_pool(args.threads)?;
+        let case = hgym::fidelity::kolmogorov::case().map_err(UsageError)?;
+        let pb = Progress::new((case.time / case.sample_interval) as u64, "kolmogorov Re 40");
+        let r = pool
+            .install(|| hgym::fidelity::kolmogorov::validate(args.level, &args.out, &mut |k, _| pb.set_position(k as u64)))
+            .context("Kolmogorov validation")?;
+        pb.finish_and_clear();
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&r)?);
+        } else {
+            println!(
+                "kolmogorov_re40 ({}, {}^2, dt {}, {} time units): D/D_lam mean {:.4} std {:.4} max {:.3}; {} bursts above {:.3} ({:.2} % of the time, {:.1} time units each)",
+                r.level, r.n, r.dt, r.time, r.mean_d_over_dlam, r.std_d_over_dlam, r.max_d_over_dlam, r.bursts,
+                r.threshold_d_over_dlam, 100.0 * r.burst_time_fraction, r.mean_burst_duration
+            );
+            for (c, ok) in &r.checks {
+                println!("  {} {c}", if *ok { "pass" } else { "FAIL" });
+            }
+            println!("  results: {}", args.out.join("kolmogorov_re40.json").display());
+        }
+        return Ok(if r.pass { Outcome::Ok } else { Outcome::CheckFailed });
+    }
+    if args.list {
+        for c in validate::bundled()? {
+            println!("{:<10} {:<18} {}", c.case.case.family, c.case.case.name, c.case.case.description);
+        }
+        return Ok(Outcome::Ok);
+    }
+    if args.names.len() > 1 && args.names.iter().any(|n| n == "kolmogorov") {
+        return Err(UsageError("run `hgym validate kolmogorov` on its own".into()).into());
+    }
+    let cases: Vec<LoadedCase> = match (args.names.is_empty(), args.cases.is_empty()) {
+        (false, false) => return Err(UsageError("give either families or --case FILE, not both".into()).into()),
+        (true, true) => {
+            let known = validate::families()?.join(", ");
+            return Err(UsageError(format!(
+                "nothing to validate: name a family ({known}) or give --case FILE; --list shows the bundled cases"
+            ))
+            .into());
+        }
+        (false, true) => {
+            let mut cases: Vec<LoadedCase> = vec![];
+            for name in &args.names {
+                for c in validate::family_cases(name)? {
+                    if !cases.iter().any(|k| k.case.case.name == c.case.case.name) {
+                        cases.push(c);
+                    }
+                }
+            }
+            cases
+        }
+        (true, false) => args.cases.iter().map(|p| validate::load_file(p)).collect::<Result<_, _>>()?,
+    };
+    let reports = run_cases(&cases, &args, &args.out)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&reports)?);
+    }
+    let all_pass = reports.iter().all(|r| r.status == Status::Pass);
+    Ok(if all_pass { Outcome::Ok } else { Outcome::CheckFailed })
+}
+
+/// Runs cases one after the other with a progress bar each, printing each report's table.
+fn run_cases(cases: &[LoadedCase], args: &ValidateArgs, out: &std::path::Path) -> Result<Vec<ValidationReport>> {
+    // Refuse unrunnable parameters for every case before running any.
+    for c in cases {
+        validate::plan(c, args.level)?;
+    }
+    let (pool, threads) = thread_pool(args.threads)?;
+    let opts = Options {
+        level: args.level,
+        out: out.to_path_buf(),
+        threads,
+    };
+    let mut reports = Vec::new();
+    for c in cases {
+        let plan = validate::plan(c, args.level)?;
+        let pb = Progress::new(plan.total_steps, &c.case.case.name);
+        let report = pool
+            .install(|| validate::validate_case(c, &opts, &mut |done, _| pb.set_position(done)))
+            .with_context(|| format!("validation case '{}'", c.case.case.name))?;
+        pb.finish_and_clear();
+        if !args.json {
+            print!("{}", report.table());
+            println!("  report: {}", out.join(format!("{}.json", report.case)).display());
+            println!();
+        }
+        reports.push(report);
+    }
+    Ok(reports)
+}
+
+/// `--env ID...`: each environment's flow with its family's references; `all`: every ID with
+/// references, each distinct flow run once and its row recorded for every ID that shares it.
+fn run_envs(args: &ValidateArgs) -> Result<Outcome> {
+    let specs = if args.envs.iter().any(|e| e == "all") {
+        hgym::env::registry::all().into_iter().filter(fidelity::has_reference).collect()
+    } else {
+        args.envs.iter().map(|id| hgym::env::spec(id)).collect::<Result<Vec<_>, _>>()?
+    };
+    let mut flows: Vec<(String, Vec<&hgym::env::EnvSpec>)> = Vec::new();
+    for s in &specs {
+        let h = s.flow_setup().hash();
+        match flows.iter_mut().find(|(k, _)| *k == h) {
+            Some((_, ids)) => ids.push(s),
+            None => flows.push((h, vec![s])),
+        }
+    }
+    let mut cases = Vec::new();
+    for (_, ids) in &flows {
+        cases.push(fidelity::env_case(ids[0], args.level)?);
+    }
+    let loaded: Vec<LoadedCase> = cases.iter().map(|(c, _)| c.clone()).collect();
+    let reports = run_cases(&loaded, args, &args.out.join("envs"))?;
+    let mut rows = Vec::new();
+    for (((_, ids), (_, case)), report) in flows.iter().zip(&cases).zip(&reports) {
+        for s in ids {
+            let e = Entry::from_report(s, report, case);
+            if !args.json {
+                println!("{:<30} {:<8} {} ({case}, {:?})", s.id, args.level.name(), e.summary(), e.status);
+            }
+            rows.push((fidelity::key(&s.id, args.level), e));
+        }
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&reports)?);
+    }
+    if args.record {
+        fidelity::record(&args.table, &rows)?;
+        if !args.json {
+            println!("recorded {} rows in {} (rebuild to embed)", rows.len(), args.table.display());
+        }
+    }
+    let all_pass = reports.iter().all(|r| r.status == Status::Pass);
+    Ok(if all_pass { Outcome::Ok } else { Outcome::CheckFailed })
+}

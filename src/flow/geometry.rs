@@ -1,0 +1,134 @@
+//! Bodies as data (`GeometrySpec`) and as the solver's signed-distance shapes (`build_shape`).
+//! Lengths are in units of the reference length; a body's own reference length (diameter, side,
+//! chord, depth or width) is the one coefficients and resolution refer to.
+
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
+
+use hgym_solvers::geometry::{Circle, Naca4, OpenCavity, Rectangle, Shape, Stenosis};
+
+/// The body. Its reference length (for Re, coefficients and resolution) is the diameter, the
+/// side, or the chord.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "shape", rename_all = "lowercase", deny_unknown_fields)]
+pub enum GeometrySpec {
+    Circle {
+        center: [f64; 2],
+        diameter: f64,
+    },
+    Square {
+        center: [f64; 2],
+        side: f64,
+    },
+    Naca {
+        digits: String,
+        chord: f64,
+        leading_edge: [f64; 2],
+        aoa_deg: f64,
+    },
+    /// An open cavity cut into a flat wall `y = leading_edge[1]` (the plate upstream and
+    /// downstream of it is solid down to the domain's bottom); reference length: the depth.
+    Cavity {
+        leading_edge: [f64; 2],
+        length: f64,
+        depth: f64,
+    },
+    /// A cosine constriction of a straight channel (the domain's walls) with its throat at
+    /// `center`; reference length: the channel width.
+    Stenosis {
+        center: [f64; 2],
+        width: f64,
+        length: f64,
+        severity: f64,
+    },
+}
+
+impl GeometrySpec {
+    pub fn reference_length(&self) -> f64 {
+        match self {
+            GeometrySpec::Circle { diameter, .. } => *diameter,
+            GeometrySpec::Square { side, .. } => *side,
+            GeometrySpec::Naca { chord, .. } => *chord,
+            GeometrySpec::Cavity { depth, .. } => *depth,
+            GeometrySpec::Stenosis { width, .. } => *width,
+        }
+    }
+
+    /// Whether fluid at `p` starts at rest when a flow is spun up from the uniform stream: below
+    /// a cavity's lips (an impulsive start with U inside the cavity sheds vortices that the thin
+    /// layer above it keeps for tens of time units); everywhere in a stenosed channel (its
+    /// oscillatory inflow starts from zero); nowhere for the other shapes.
+    pub fn starts_at_rest(&self, p: [f64; 2]) -> bool {
+        match self {
+            GeometrySpec::Cavity { leading_edge, .. } => p[1] < leading_edge[1],
+            GeometrySpec::Stenosis { .. } => true,
+            _ => false,
+        }
+    }
+
+    /// A point at the body's centre (for the initial perturbation).
+    pub fn center(&self) -> [f64; 2] {
+        match self {
+            GeometrySpec::Circle { center, .. } | GeometrySpec::Square { center, .. } | GeometrySpec::Stenosis { center, .. } => *center,
+            GeometrySpec::Naca { chord, leading_edge, .. } => [leading_edge[0] + 0.5 * chord, leading_edge[1]],
+            GeometrySpec::Cavity {
+                leading_edge,
+                length,
+                depth,
+            } => [leading_edge[0] + 0.5 * length, leading_edge[1] - 0.5 * depth],
+        }
+    }
+
+    /// Whether the body stands free in the flow (circle, square, aerofoil), as opposed to a wall
+    /// feature that reaches the domain's edges (a cavity's plate, a stenosed channel's walls).
+    pub fn is_immersed(&self) -> bool {
+        matches!(self, GeometrySpec::Circle { .. } | GeometrySpec::Square { .. } | GeometrySpec::Naca { .. })
+    }
+
+    /// The body as the solver's signed-distance shape.
+    pub fn shape(&self) -> Arc<dyn Shape> {
+        match self {
+            GeometrySpec::Circle { center, diameter } => Arc::new(Circle {
+                center: *center,
+                radius: 0.5 * diameter,
+            }),
+            GeometrySpec::Square { center, side } => Arc::new(Rectangle {
+                center: *center,
+                size: [*side, *side],
+            }),
+            GeometrySpec::Naca {
+                digits,
+                chord,
+                leading_edge,
+                aoa_deg,
+            } => {
+                // Digits are checked by `FlowSetup::check`; fall back to a symmetric 12 % section.
+                Arc::new(
+                    Naca4::from_digits(digits, *chord, *leading_edge, *aoa_deg)
+                        .unwrap_or_else(|| Naca4::new(0.0, 0.0, 0.12, *chord, *leading_edge, *aoa_deg)),
+                )
+            }
+            GeometrySpec::Cavity {
+                leading_edge,
+                length,
+                depth,
+            } => Arc::new(OpenCavity {
+                leading_edge: *leading_edge,
+                length: *length,
+                depth: *depth,
+            }),
+            GeometrySpec::Stenosis {
+                center,
+                width,
+                length,
+                severity,
+            } => Arc::new(Stenosis {
+                center: *center,
+                width: *width,
+                length: *length,
+                severity: *severity,
+            }),
+        }
+    }
+}

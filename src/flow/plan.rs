@@ -1,0 +1,177 @@
+//! Lattice numbers of a flow at a level: grid size, relaxation time, Mach number, and the node
+//! ranges of refined patches; refusals of what cannot run (tau too close to 1/2, grids too small
+//! or too large).
+
+use serde::{Deserialize, Serialize};
+
+use hgym_solvers::lbm::{Collision, Patch, Units};
+
+use super::{DomainSpec, FlowError, FlowSetup, Level};
+
+/// Largest lattice speed anywhere on the inlet (Mach 0.3 = 0.173 lattice units): above it the
+/// compressibility error of the LBM exceeds a few percent.
+pub const MAX_LATTICE_SPEED: f64 = 0.173;
+/// Largest grid accepted (nodes), about 3.6 GB of populations.
+pub const MAX_NODES: usize = 50_000_000;
+
+/// Nested refined rectangles `[x0, x1, y0, y1]` (reference lengths), coarsest first: inside the
+/// first the grid is twice as fine as the level's (`cells_per_length` applies outside), inside
+/// the second four times, and so on. Each lies inside the one before; the last contains every
+/// body with some room; the first stays clear of the domain's edges and absorbing layers.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RefinementSpec {
+    pub regions: Vec<[f64; 4]>,
+}
+
+impl RefinementSpec {
+    /// Every region a proper rectangle strictly inside the domain or the region before it.
+    pub fn check(&self, d: &DomainSpec) -> Result<(), FlowError> {
+        let bad = |message: String| FlowError::Invalid {
+            field: "refinement.regions",
+            message,
+        };
+        if self.regions.is_empty() {
+            return Err(bad("list at least one region [x0, x1, y0, y1]".into()));
+        }
+        let mut outer = [d.x[0], d.x[1], d.y[0], d.y[1]];
+        for (k, region) in self.regions.iter().enumerate() {
+            let [x0, x1, y0, y1] = *region;
+            if !(region.iter().all(|v| v.is_finite()) && x0 < x1 && y0 < y1) {
+                return Err(bad(format!(
+                    "region {} must be [x0, x1, y0, y1] with x0 < x1 and y0 < y1, got {region:?}",
+                    k + 1
+                )));
+            }
+            if x0 <= outer[0] || x1 >= outer[1] || y0 <= outer[2] || y1 >= outer[3] {
+                return Err(bad(format!(
+                    "region {} {region:?} must lie inside {} {outer:?} with room to spare",
+                    k + 1,
+                    if k == 0 { "the domain".to_string() } else { format!("region {k}") }
+                )));
+            }
+            outer = *region;
+        }
+        Ok(())
+    }
+}
+
+/// Lattice numbers of the nested patches: each in the node indices of the grid it refines
+/// (ranges inclusive), and the finest grid's cells per length and relaxation time
+/// (`tau_l - 1/2 = 2^l (tau - 1/2)`).
+#[derive(Clone, Debug, Serialize)]
+pub struct RefinementPlan {
+    pub patches: Vec<Patch>,
+    pub cells_per_length: f64,
+    pub tau: f64,
+}
+
+/// Lattice numbers of a flow at one level.
+#[derive(Clone, Debug, Serialize)]
+pub struct FlowPlan {
+    pub level: Level,
+    pub units: Units,
+    pub nx: usize,
+    pub ny: usize,
+    /// Grid spacing in the set-up's length units (`L / cells_per_length`).
+    pub dx: f64,
+    pub tau: f64,
+    pub mach: f64,
+    pub collision: Collision,
+    /// The nested patches, if the set-up has refinement regions.
+    pub refinement: Option<RefinementPlan>,
+}
+
+impl FlowSetup {
+    /// The lattice numbers at `level`: `n` cells per reference length L, `tau` from Re, U and
+    /// `n`; refused when `tau - 1/2` is below the collision operator's margin, or the grid is
+    /// smaller than 8 x 8 or larger than [`MAX_NODES`].
+    pub fn plan(&self, level: Level) -> Result<FlowPlan, FlowError> {
+        let l = self.reference_length();
+        let n = self.resolution.at(level) as f64;
+        let units = Units {
+            cells_per_length: n,
+            u_lattice: self.lattice_velocity,
+            reynolds: self.reynolds,
+        };
+        let tau = units.tau();
+        let margin = self.collision.min_tau_margin();
+        if tau - 0.5 < margin {
+            let n_min = (margin * self.reynolds / (3.0 * self.lattice_velocity)).ceil();
+            return Err(FlowError::Invalid {
+                field: "resolution",
+                message: format!(
+                    "at the {} level ({n} cells per length) tau = {tau:.5} is too close to 1/2 for the {} collision \
+                     (tau - 1/2 must be >= {margin}); use at least {n_min} cells per length, a larger lattice_velocity, \
+                     or collision = \"regularized\"",
+                    level.name(),
+                    self.collision.name()
+                ),
+            });
+        }
+        let d = &self.domain;
+        let nx_f = (d.x[1] - d.x[0]) * n / l;
+        let ny_f = (d.y[1] - d.y[0]) * n / l;
+        // Compared as floats first: a huge domain must not wrap when cast to usize.
+        if !(nx_f * ny_f <= MAX_NODES as f64) {
+            return Err(FlowError::Invalid {
+                field: "resolution",
+                message: format!(
+                    "{nx_f:.0} x {ny_f:.0} cells exceeds the limit of {MAX_NODES}; use a coarser level or a smaller domain"
+                ),
+            });
+        }
+        let (nx, ny) = (nx_f.round() as usize, ny_f.round() as usize);
+        if nx < 8 || ny < 8 {
+            return Err(FlowError::Invalid {
+                field: "domain",
+                message: format!("{nx} x {ny} cells is too small; enlarge the domain or the resolution"),
+            });
+        }
+        if nx * ny > MAX_NODES {
+            return Err(FlowError::Invalid {
+                field: "resolution",
+                message: format!(
+                    "{nx} x {ny} = {} cells exceeds the limit of {MAX_NODES}; use a coarser level or a smaller domain",
+                    nx * ny
+                ),
+            });
+        }
+        // Cell-centred nodes: level-0 node i sits at x0 + (i + 1/2) dx; a patch takes the nodes
+        // of the grid it refines that cover its region, and its own node 0 sits on the first.
+        let refinement = self.refinement.as_ref().map(|rf| {
+            let mut origin = [d.x[0] + 0.5 * l / n, d.y[0] + 0.5 * l / n];
+            let (mut dx, mut size) = (l / n, [nx, ny]);
+            let mut patches = Vec::new();
+            for [rx0, rx1, ry0, ry1] in rf.regions.iter().copied() {
+                let lo = |v: f64, o: f64, n: usize| (((v - o) / dx).floor().max(0.0) as usize).min(n - 1);
+                let hi = |v: f64, o: f64, n: usize| (((v - o) / dx).ceil().max(0.0) as usize).min(n - 1);
+                let p = Patch {
+                    x: [lo(rx0, origin[0], size[0]), hi(rx1, origin[0], size[0])],
+                    y: [lo(ry0, origin[1], size[1]), hi(ry1, origin[1], size[1])],
+                };
+                origin = [origin[0] + p.x[0] as f64 * dx, origin[1] + p.y[0] as f64 * dx];
+                dx *= 0.5;
+                size = [2 * (p.x[1] - p.x[0]) + 1, 2 * (p.y[1] - p.y[0]) + 1];
+                patches.push(p);
+            }
+            let scale = (1u64 << patches.len()) as f64;
+            RefinementPlan {
+                patches,
+                cells_per_length: scale * n,
+                tau: 0.5 + scale * (tau - 0.5),
+            }
+        });
+        Ok(FlowPlan {
+            level,
+            units,
+            nx,
+            ny,
+            dx: l / n,
+            tau,
+            mach: units.mach(),
+            collision: self.collision,
+            refinement,
+        })
+    }
+}

@@ -1,0 +1,41 @@
+//! Committed results stay reproducible: every result folder under `results/` was run on the spec
+//! its ID has now (same SHA-256), so a refactor that changes a spec's hash, or its physics,
+//! fails here rather than silently orphaning the results. The folders run on specs that changed
+//! since are listed below with the reason; they are to be regenerated (issue: leaderboard on
+//! current specs), never silently dropped.
+
+mod common;
+use common::{files_under, repo};
+
+/// Result folders run on an earlier spec of their ID: (folder prefix under results/, why).
+const STALE: &[(&str, &str)] = &[
+    ("compare/kolmogorov_gppo/", "Kolmogorov_2D_Re40's spec changed after the GPPO comparison"),
+    ("train/Pinball_2D_Re100-td3-coarse/", "trained on the pinball's earlier reward"),
+    ("runs/Pinball_2D_Re", "the pinball's domain and reward changed after these showcase runs"),
+    ("runs/SquareCylinder_2D_Re", "the square cylinder's set-up changed after these showcase runs"),
+];
+
+#[test]
+fn committed_results_were_run_on_the_registered_specs() {
+    let results = repo().join("results");
+    let files = files_under(&results, &|p| p.file_name().is_some_and(|n| n == "manifest.json"));
+    let mut current = 0;
+    let mut problems = vec![];
+    for f in &files {
+        let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(f).unwrap()).unwrap();
+        let (Some(id), Some(hash)) = (m["env_id"].as_str(), m["spec_hash"].as_str()) else {
+            continue;
+        };
+        let rel = f.strip_prefix(&results).unwrap().to_string_lossy().replace('\\', "/");
+        let stale = STALE.iter().any(|(prefix, _)| rel.starts_with(prefix));
+        let registered = hgym::env::any::lookup(id).unwrap_or_else(|e| panic!("{rel}: {e}")).hash();
+        match (registered == hash, stale) {
+            (true, false) => current += 1,
+            (false, true) => {}
+            (true, true) => problems.push(format!("{rel}: listed as stale but its spec is current; remove it from STALE")),
+            (false, false) => problems.push(format!("{rel}: {id} was run on spec {hash}, registered now as {registered}")),
+        }
+    }
+    assert!(problems.is_empty(), "{problems:#?}");
+    assert!(current >= 20, "expected the committed runs on current specs, found {current}");
+}
