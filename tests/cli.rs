@@ -506,7 +506,10 @@ fn validate_env_runs_the_environment_flow_and_reports_deviations() {
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("envs/Cylinder_2D_Re100-coarse.json")).unwrap()).unwrap();
     schema_check(&report);
     assert_eq!(report["origin"], "env:Cylinder_2D_Re100");
-    assert_eq!(report["parameters"]["nx"], 320, "the environment's [0, 40] x [-10, 10] at 8 cells per D");
+    assert_eq!(
+        report["parameters"]["nx"], 320,
+        "the environment's [0, 40] x [-10, 10] at 8 cells per D"
+    );
     let spec = hgym::env::spec("Cylinder_2D_Re100").unwrap();
     let committed = hgym::fidelity::committed(&spec, Level::Coarse).expect("a committed coarse row");
     assert!(stdout.contains(&committed.summary()), "{stdout}");
@@ -529,7 +532,11 @@ fn the_export_help_example_runs_on_the_committed_results() {
         .skip(1)
         .map(|a| if a == "OUT" { out.display().to_string() } else { a.to_string() })
         .collect();
-    let o = Command::new(env!("CARGO_BIN_EXE_hgym")).args(&args).current_dir(repo()).output().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_hgym"))
+        .args(&args)
+        .current_dir(repo())
+        .output()
+        .unwrap();
     let (stdout, err) = text(&o);
     assert!(o.status.success(), "`{example}`: {stdout}{err}");
     assert!(out.join("README.md").is_file(), "`{example}` wrote no dataset card");

@@ -9,10 +9,19 @@ use common::{files_under, repo};
 
 /// Result folders run on an earlier spec of their ID: (folder prefix under results/, why).
 const STALE: &[(&str, &str)] = &[
-    ("compare/kolmogorov_gppo/", "Kolmogorov_2D_Re40's spec changed after the GPPO comparison"),
+    (
+        "compare/kolmogorov_gppo/",
+        "Kolmogorov_2D_Re40's spec changed after the GPPO comparison",
+    ),
     ("train/Pinball_2D_Re100-td3-coarse/", "trained on the pinball's earlier reward"),
-    ("runs/Pinball_2D_Re", "the pinball's domain and reward changed after these showcase runs"),
-    ("runs/SquareCylinder_2D_Re", "the square cylinder's set-up changed after these showcase runs"),
+    (
+        "runs/Pinball_2D_Re",
+        "the pinball's domain and reward changed after these showcase runs",
+    ),
+    (
+        "runs/SquareCylinder_2D_Re",
+        "the square cylinder's set-up changed after these showcase runs",
+    ),
 ];
 
 #[test]

@@ -54,7 +54,11 @@ fn drag_lift_reward_of_the_cylinder() {
     let (f, r) = first_interval("Cylinder_2D_Re100");
     let [c_d, c_l] = f[0];
     assert!(c_d > 1.0 && c_d < 2.0, "C_D {c_d}");
-    assert!(close(info(&r, "C_D_0"), c_d) && close(info(&r, "C_L_0"), c_l), "{:?} vs {f:?}", r.info);
+    assert!(
+        close(info(&r, "C_D_0"), c_d) && close(info(&r, "C_L_0"), c_l),
+        "{:?} vs {f:?}",
+        r.info
+    );
     assert!(close(info(&r, "C_D"), c_d) && close(info(&r, "C_L"), c_l));
     let expected = -c_d.abs() - 0.1 * c_l.abs();
     assert!(close(r.reward, expected), "reward {} vs {expected}", r.reward);
@@ -86,7 +90,12 @@ fn gust_loads_reward_of_the_aerofoil() {
     let (f, r) = first_interval(id);
     let [c_d, c_l] = f[0];
     assert!(close(info(&r, "C_D"), c_d) && close(info(&r, "C_L"), c_l));
-    let hgym::env::spec::RewardSpec::GustLoads { c_l_ref, c_d_ref, drag_weight } = spec(id).unwrap().reward else {
+    let hgym::env::spec::RewardSpec::GustLoads {
+        c_l_ref,
+        c_d_ref,
+        drag_weight,
+    } = spec(id).unwrap().reward
+    else {
         panic!("the gust reward kind changed");
     };
     let expected = -(c_l - c_l_ref).abs() - drag_weight * (c_d - c_d_ref).abs();
@@ -109,7 +118,11 @@ fn probe_deviation_reward_of_the_cavity() {
         .zip(norm.mean.iter().zip(&norm.scale))
         .map(|(o, (m, s))| ((o - m) / (s / 3.0)).powi(2))
         .sum::<f64>();
-    assert!((r.reward - expected).abs() <= 1e-9 * (1.0 + expected.abs()), "reward {} vs {expected}", r.reward);
+    assert!(
+        (r.reward - expected).abs() <= 1e-9 * (1.0 + expected.abs()),
+        "reward {} vs {expected}",
+        r.reward
+    );
 }
 
 /// Stenotic pipe: `r = -w |T(probe) / T_wall - target|`, with `T` read by name from `info`.

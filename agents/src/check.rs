@@ -42,7 +42,10 @@ pub fn check_env(env: &mut dyn Env, episode_actions: usize, seed: u64) -> Vec<Vi
     // Spaces.
     for (name, space) in [("observation_space", &obs_space), ("action_space", &act_space)] {
         if space.low.len() != space.high.len() {
-            fail("spaces", format!("{name}: {} lower and {} upper bounds", space.low.len(), space.high.len()));
+            fail(
+                "spaces",
+                format!("{name}: {} lower and {} upper bounds", space.low.len(), space.high.len()),
+            );
         }
         // Infinite bounds are allowed (Gymnasium's Box takes them); NaN and low > high are not.
         if space.low.iter().zip(&space.high).any(|(l, h)| !(l <= h)) {
@@ -50,7 +53,10 @@ pub fn check_env(env: &mut dyn Env, episode_actions: usize, seed: u64) -> Vec<Vi
         }
     }
     if act_space.low.iter().any(|l| *l != -1.0) || act_space.high.iter().any(|h| *h != 1.0) {
-        fail("spaces", "actions must be exactly in [-1, 1] (mapped to physical bounds inside the env)".into());
+        fail(
+            "spaces",
+            "actions must be exactly in [-1, 1] (mapped to physical bounds inside the env)".into(),
+        );
     }
     if act_space.dim() == 0 {
         fail("spaces", "the action space is empty".into());
@@ -59,7 +65,10 @@ pub fn check_env(env: &mut dyn Env, episode_actions: usize, seed: u64) -> Vec<Vi
     // Reset.
     let observation = |check: &'static str, obs: &[f64], fail: &mut dyn FnMut(&'static str, String)| {
         if obs.len() != obs_space.dim() {
-            fail(check, format!("observation has {} values, the space {}", obs.len(), obs_space.dim()));
+            fail(
+                check,
+                format!("observation has {} values, the space {}", obs.len(), obs_space.dim()),
+            );
         } else if !obs.iter().all(|x| x.is_finite()) {
             fail(check, "observation has non-finite values".into());
         } else if !obs_space.contains(obs) {
@@ -80,7 +89,10 @@ pub fn check_env(env: &mut dyn Env, episode_actions: usize, seed: u64) -> Vec<Vi
                 fail("reset determinism", format!("reset({seed}) twice gives different observations"));
             }
             if other == first {
-                fail("reset seeding", format!("reset({seed}) and reset({}) start from the same state", seed.wrapping_add(1)));
+                fail(
+                    "reset seeding",
+                    format!("reset({seed}) and reset({}) start from the same state", seed.wrapping_add(1)),
+                );
             }
         }
         (Err(e), _) | (_, Err(e)) => fail("reset", format!("a second reset failed: {e}")),

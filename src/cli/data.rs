@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use anyhow::Result;
-use clap::{Args, ValueEnum};
+use clap::{Args, Subcommand, ValueEnum};
 use hgym::data::hf::{export, ExportOptions};
 use hgym::data::hub::{self, HubConfig, HubError};
 
@@ -51,7 +51,7 @@ pub fn run_export(args: ExportArgs) -> Result<Outcome> {
         ..ExportOptions::default()
     };
     let paths = hgym::data::hf::find_trajectories(&args.dir).map_err(UsageError)?;
-    let pb = crate::Progress::new(paths.len() as u64, "reading");
+    let pb = super::progress::Progress::new(paths.len() as u64, "reading");
     let report = export(&args.dir, &args.out, &opts, &mut |k, _| pb.set_position(k as u64)).map_err(UsageError)?;
     pb.finish_and_clear();
     if args.json {
@@ -129,6 +129,42 @@ pub fn run_push(args: PushArgs) -> Result<Outcome> {
             report.lfs_files,
             report.url,
             if report.created { " (new repository)" } else { "" }
+        );
+    }
+    Ok(Outcome::Ok)
+}
+
+#[derive(Subcommand)]
+pub enum DataCommand {
+    /// Copy every complete chunk (and the metadata) of a damaged MCAP file into a valid one.
+    Recover {
+        file: PathBuf,
+        /// Output file (default: <file>.recovered.mcap).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// `hgym data recover`.
+pub fn run_data(cmd: DataCommand) -> Result<Outcome> {
+    let DataCommand::Recover { file, out, json } = cmd;
+    let out = out.unwrap_or_else(|| file.with_extension("recovered.mcap"));
+    let r = hgym::data::trajectory::recover(&file, &out).map_err(UsageError)?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&r)?);
+    } else {
+        println!(
+            "recovered {} messages and {} metadata records from {} into {}{}",
+            r.messages,
+            r.metadata,
+            file.display(),
+            out.display(),
+            r.stopped_at
+                .as_ref()
+                .map(|e| format!("\n  lost: everything after the last complete chunk (reading stopped: {e})"))
+                .unwrap_or_else(|| "\n  nothing lost: the file was complete".into())
         );
     }
     Ok(Outcome::Ok)

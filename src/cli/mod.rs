@@ -1,9 +1,13 @@
-//! Subcommands of the binary that grew past a few lines: `train`, `eval`, `bench agents`;
-//! `export`, `push`; progress reports for long runs.
+//! One file per command (its clap arguments and its `run`): `validate`, `bench`, `envs`, `run`,
+//! `train`/`eval`/`compare`, `export`/`push`/`data`, `plot`/`leaderboard`; progress reports for
+//! long runs; standard output that survives a closed pipe.
 
+pub mod bench;
 pub mod data;
+pub mod envs;
 pub mod out;
+pub mod plot;
 pub mod progress;
-
+pub mod run;
 pub mod train;
 pub mod validate;

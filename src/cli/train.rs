@@ -5,10 +5,10 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use anyhow::{Context, Result};
 use clap::Args;
+use hgym::flow::Level;
 use hgym::train::config::TrainConfig;
 use hgym::train::eval::{evaluate, parse_policy, uncontrolled_c_d, EvalReport, NamedPolicy};
 use hgym::train::{resolve_spec, resume_options, summarize, Ending, TrainError, TrainOptions};
-use hgym::flow::Level;
 use hgym_agents::baselines::BaselinePolicy;
 use hgym_agents::learn::Algo;
 use hgym_agents::policy::Policy;

@@ -26,7 +26,7 @@ use hgym_solvers::lbm::{D2q9, Edge, LbmError, Side, Units};
 use super::actuation::{apply, Jet, WallMotion};
 use super::seeding::splitmix64;
 use super::spec::{ActuationSpec, EnvSpec, RewardSpec};
-use crate::flow::{FlowError, GeometrySpec, Level, LbmFlow};
+use crate::flow::{FlowError, GeometrySpec, LbmFlow, Level};
 
 pub struct LbmEnv {
     spec: EnvSpec,

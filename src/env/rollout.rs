@@ -10,10 +10,10 @@ use serde::{Deserialize, Serialize};
 use super::spec::EnvSpec;
 use super::LbmEnv;
 use crate::env::fields::FlowFields;
+use crate::flow::vorticity_field;
+use crate::flow::Level;
 use crate::report::manifest::{manifest, Manifest};
 use crate::report::plots;
-use crate::flow::Level;
-use crate::flow::vorticity_field;
 
 /// Open-loop policies for smoke runs and baselines.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
@@ -208,7 +208,8 @@ fn write(dir: &Path, summary: &RolloutManifest, m: &Metrics, env: &LbmEnv) -> Re
     plots::time_series(&dir.join("rollout.png"), &title, &m.t, &panels, None)?;
     let d = &summary.spec.domain;
     let v = vorticity_field(env.solver(), env.units(), [d.x[0], d.x[1], d.y[0], d.y[1]]);
-    crate::report::plots::field_png(&v, 
+    crate::report::plots::field_png(
+        &v,
         &dir.join("vorticity.png"),
         &format!("{}: vorticity w L/U at the end", summary.env_id),
     )?;

@@ -14,8 +14,8 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::env::kolmogorov::{spec, KolmogorovEnv};
-use crate::report::plots;
 use crate::flow::Level;
+use crate::report::plots;
 use hgym_agents::{Env, EnvError};
 
 /// The committed case file.

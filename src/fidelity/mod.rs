@@ -156,7 +156,9 @@ pub fn has_reference(spec: &EnvSpec) -> bool {
     let Some(case) = spec.validation_case() else {
         return false;
     };
-    validate::case::BUNDLED.iter().any(|(file, _)| file.strip_suffix(".toml") == Some(case.as_str()))
+    validate::case::BUNDLED
+        .iter()
+        .any(|(file, _)| file.strip_suffix(".toml") == Some(case.as_str()))
 }
 
 /// Writes `rows` into the table at `path` (re-read first, so rows recorded meanwhile by other

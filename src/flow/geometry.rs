@@ -83,7 +83,10 @@ impl GeometrySpec {
     /// Whether the body stands free in the flow (circle, square, aerofoil), as opposed to a wall
     /// feature that reaches the domain's edges (a cavity's plate, a stenosed channel's walls).
     pub fn is_immersed(&self) -> bool {
-        matches!(self, GeometrySpec::Circle { .. } | GeometrySpec::Square { .. } | GeometrySpec::Naca { .. })
+        matches!(
+            self,
+            GeometrySpec::Circle { .. } | GeometrySpec::Square { .. } | GeometrySpec::Naca { .. }
+        )
     }
 
     /// The body as the solver's signed-distance shape.

@@ -121,7 +121,10 @@ impl FlowSetup {
             return Err(bad("domain", "x and y must be finite [min, max] pairs with min < max"));
         }
         let Some(first) = self.bodies.first() else {
-            return Err(bad("bodies", "give at least one body: the first one's length is the reference length"));
+            return Err(bad(
+                "bodies",
+                "give at least one body: the first one's length is the reference length",
+            ));
         };
         let l = first.reference_length();
         if !(l.is_finite() && l > 0.0) {

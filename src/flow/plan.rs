@@ -116,9 +116,7 @@ impl FlowSetup {
         if !(nx_f * ny_f <= MAX_NODES as f64) {
             return Err(FlowError::Invalid {
                 field: "resolution",
-                message: format!(
-                    "{nx_f:.0} x {ny_f:.0} cells exceeds the limit of {MAX_NODES}; use a coarser level or a smaller domain"
-                ),
+                message: format!("{nx_f:.0} x {ny_f:.0} cells exceeds the limit of {MAX_NODES}; use a coarser level or a smaller domain"),
             });
         }
         let (nx, ny) = (nx_f.round() as usize, ny_f.round() as usize);

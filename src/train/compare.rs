@@ -17,8 +17,8 @@ use serde::{Deserialize, Serialize};
 use super::config::TrainConfig;
 use super::curve::{from_csv, CurveRow};
 use super::eval::{evaluate, Stat};
-use crate::report::plots;
 use crate::flow::Level;
+use crate::report::plots;
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]

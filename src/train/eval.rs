@@ -11,7 +11,6 @@ use hgym_agents::rollout::{episode, EpisodeAccumulator, EpisodeStats};
 use crate::data::trajectory::TrajectoryWriter;
 use hgym_agents::{Env, EnvError};
 
-
 pub use crate::report::eval::{nan_if_null, EvalEpisode, EvalReport, Stat};
 
 /// The mean C_D of each uncontrolled episode from `reset(seed)` for `seeds`.

@@ -29,8 +29,8 @@ use self::config::TrainConfig;
 use self::curve::CurveRow;
 use self::eval::{evaluate, uncontrolled_c_d, EvalReport, Stat};
 use crate::env::any::{AnyEnv, AnySpec};
-use crate::report::manifest::{manifest, Manifest};
 use crate::flow::Level;
+use crate::report::manifest::{manifest, Manifest};
 
 #[derive(Debug, thiserror::Error)]
 pub enum TrainError {

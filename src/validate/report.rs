@@ -441,7 +441,8 @@ pub fn write_plots(r: &ValidationReport, out: &RunOutput, dir: &Path) -> Result<
         &marks,
     )?;
     let t_end = out.t.last().copied().unwrap_or(0.0);
-    plots::field_png(&out.vorticity, 
+    plots::field_png(
+        &out.vorticity,
         &dir.join("vorticity.png"),
         &format!("{}: vorticity w L/U at t = {t_end:.1}", r.case),
     )?;

@@ -26,10 +26,7 @@ pub struct Plan {
 impl Plan {
     pub fn new(c: &LoadedCase, level: Level) -> Result<Self, ValidateError> {
         let case = &c.case;
-        let flow = case
-            .flow_setup()
-            .plan(level)
-            .map_err(|e| flow_error(&case.case.name, e))?;
+        let flow = case.flow_setup().plan(level).map_err(|e| flow_error(&case.case.name, e))?;
         // Time is in units of L/U.
         let spin_up_steps = flow.units.steps(case.time.spin_up);
         let total_steps = spin_up_steps + flow.units.steps(case.time.average);

@@ -1,0 +1,186 @@
+//! `hgym bench`: speed against the machine's limits (LBM kernel, refinement, environments,
+//! learners, the spectral solver).
+
+use anyhow::{Context, Result};
+use clap::Subcommand;
+
+use crate::{Outcome, UsageError};
+use hgym::bench::{bench_lbm, bench_refine, LbmBenchOptions, RefineBenchOptions};
+use hgym::flow::Level;
+
+#[derive(Subcommand)]
+pub enum BenchCommand {
+    /// D2Q9 lattice-Boltzmann step: MLUPS at three sizes, 1 and 2 threads, against a STREAM copy
+    /// measured in the same run. Exit 1 if the memory-bound size reaches less than 70 % of the
+    /// roofline.
+    Lbm {
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+        /// A fast smoke run (small sizes, short timings; the target is not judged).
+        #[arg(long)]
+        quick: bool,
+        /// Collision operator to time.
+        #[arg(long, value_enum, default_value = "regularized")]
+        collision: CollisionArg,
+    },
+    /// 2:1 grid refinement: node updates per second of a grid with a patch over its middle
+    /// quarter against the uniform kernel on the same grid, 1 and 2 threads. Exit 1 if the refined
+    /// rate is below 80 % of the uniform one with all threads.
+    Refine {
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+        /// A fast smoke run (a small grid, short timings; the target is not judged).
+        #[arg(long)]
+        quick: bool,
+    },
+    /// Learner speed: TD3 updates/s (256x256, batch 256), PPO epochs/s (64x64), batch-1 policy
+    /// latency, against SB3 measured on this machine. Exit 1 if short of the targets.
+    Agents {
+        #[arg(long)]
+        json: bool,
+        /// Short timings (targets not judged).
+        #[arg(long)]
+        quick: bool,
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+    /// Spectral Kolmogorov solver: steps/s at N 64-256, VJP cost, accuracy against step size,
+    /// against HydroGym's JAX env measured on this machine. Exit 1 if short of the targets.
+    Kolmogorov {
+        #[arg(long)]
+        json: bool,
+        /// Short timings and a 1-time-unit action (targets not judged).
+        #[arg(long)]
+        quick: bool,
+    },
+    /// Control steps (actions) per second of each environment family at coarse and default.
+    Envs {
+        /// Print the rows as JSON.
+        #[arg(long)]
+        json: bool,
+        /// Actions timed per family and level.
+        #[arg(long, default_value_t = 20)]
+        actions: usize,
+        /// Only the coarse level (fast smoke run).
+        #[arg(long)]
+        quick: bool,
+        /// Only this family (repeatable), e.g. `--family stenotic_pipe`; an unknown name lists the families.
+        #[arg(long)]
+        family: Vec<String>,
+    },
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum CollisionArg {
+    /// Single-relaxation-time BGK.
+    Bgk,
+    /// Regularised BGK (Latt & Chopard 2006), the default of every case and environment.
+    Regularized,
+    /// Recursive regularised BGK (Malaspinas 2015; Coreixas et al. 2017).
+    Recursive,
+}
+
+/// Runs one benchmark.
+pub fn run(cmd: BenchCommand) -> Result<Outcome> {
+    match cmd {
+        BenchCommand::Lbm { json, quick, collision } => run_bench(json, quick, collision),
+        BenchCommand::Refine { json, quick } => run_bench_refine(json, quick),
+        BenchCommand::Envs {
+            json,
+            actions,
+            quick,
+            family,
+        } => run_bench_envs(json, actions, quick, &family),
+        BenchCommand::Agents { json, quick, threads } => super::train::run_bench_agents(json, quick, threads),
+        BenchCommand::Kolmogorov { json, quick } => {
+            let b = hgym::bench::kolmogorov::bench_kolmogorov(quick);
+            if json {
+                println!("{}", serde_json::to_string_pretty(&b)?);
+            } else {
+                print!("{}", hgym::bench::kolmogorov::table(&b));
+            }
+            Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
+        }
+    }
+}
+
+fn run_bench(json: bool, quick: bool, collision: CollisionArg) -> Result<Outcome> {
+    let mut opts = LbmBenchOptions {
+        collision: match collision {
+            CollisionArg::Bgk => hgym_solvers::lbm::Collision::Bgk,
+            CollisionArg::Regularized => hgym_solvers::lbm::Collision::Regularized,
+            CollisionArg::Recursive => hgym_solvers::lbm::Collision::Recursive,
+        },
+        ..LbmBenchOptions::default()
+    };
+    if quick {
+        opts.sizes = vec![(32, 32), (128, 64), (256, 256)];
+        opts.seconds = 0.05;
+        opts.stream_values = 1 << 22;
+    }
+    let quiet = json;
+    let report = bench_lbm(&opts, &mut |msg| {
+        if !quiet {
+            eprintln!("{msg}");
+        }
+    })
+    .map_err(anyhow::Error::msg)
+    .context("LBM benchmark")?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", report.table());
+    }
+    Ok(if report.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
+}
+
+fn run_bench_refine(json: bool, quick: bool) -> Result<Outcome> {
+    let mut opts = RefineBenchOptions::default();
+    if quick {
+        opts.n = 128;
+        opts.seconds = 0.05;
+    }
+    let report = bench_refine(&opts, &mut |msg| {
+        if !json {
+            eprintln!("{msg}");
+        }
+    })
+    .map_err(anyhow::Error::msg)
+    .context("refinement benchmark")?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", report.table());
+    }
+    Ok(if report.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
+}
+
+fn run_bench_envs(json: bool, actions: usize, quick: bool, families: &[String]) -> Result<Outcome> {
+    if actions == 0 {
+        return Err(UsageError("--actions must be at least 1".into()).into());
+    }
+    let known = hgym::bench::envs::families();
+    if let Some(f) = families.iter().find(|f| !known.contains(f)) {
+        return Err(UsageError(format!("unknown family '{f}'; the families are: {}", known.join(", "))).into());
+    }
+    let levels: &[Level] = if quick {
+        &[Level::Coarse]
+    } else {
+        &[Level::Coarse, Level::Default]
+    };
+    let rows = hgym::bench::envs::bench_envs(levels, actions, families, hgym::env::default_cache_dir(), &mut |m| {
+        if !json {
+            eprintln!("{m}");
+        }
+    })
+    .map_err(anyhow::Error::msg)
+    .context("environment benchmark")?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        print!("{}", hgym::bench::envs::table(&rows));
+    }
+    Ok(Outcome::Ok)
+}

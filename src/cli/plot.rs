@@ -1,0 +1,114 @@
+//! `hgym plot` (learning curves of several runs in one figure) and `hgym leaderboard`.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+
+use crate::{Outcome, UsageError};
+
+/// Learning curves of several training runs in one figure.
+#[derive(Args)]
+pub struct PlotArgs {
+    /// Training result folders (each with curve.csv).
+    #[arg(required = true)]
+    runs: Vec<PathBuf>,
+    /// Output PNG.
+    #[arg(short, long, default_value = "learning_curves.png")]
+    out: PathBuf,
+    /// Plot the evaluation drag reduction instead of the return.
+    #[arg(long)]
+    drag: bool,
+    /// Plot the training return (with exploration) instead of the evaluation return.
+    #[arg(long)]
+    train: bool,
+}
+
+/// The leaderboard's sources and output.
+#[derive(Args)]
+pub struct LeaderboardArgs {
+    /// Only this environment.
+    #[arg(long)]
+    env: Option<String>,
+    /// The results folder.
+    #[arg(long, default_value = "results")]
+    results: PathBuf,
+    #[arg(long)]
+    json: bool,
+}
+
+/// `hgym leaderboard`: writes results/leaderboard.json, LEADERBOARD.md and the bar charts.
+pub fn leaderboard(args: LeaderboardArgs) -> Result<Outcome> {
+    let lb = hgym::report::leaderboard::build(&args.results, args.env.as_deref());
+    hgym::report::leaderboard::write(&args.results, &lb).map_err(anyhow::Error::msg)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&lb)?);
+    } else {
+        print!("{}", hgym::report::leaderboard::markdown(&lb));
+    }
+    Ok(Outcome::Ok)
+}
+
+/// `hgym plot`.
+pub fn plot(args: PlotArgs) -> Result<Outcome> {
+    run_plot(&args.runs, &args.out, args.drag, args.train)
+}
+
+fn run_plot(runs: &[PathBuf], out: &std::path::Path, drag: bool, train: bool) -> Result<Outcome> {
+    use hgym::report::plots::{lines, Line};
+    let mut series: Vec<(String, Vec<f64>, Vec<f64>)> = vec![];
+    for dir in runs {
+        let file = dir.join("curve.csv");
+        let text = std::fs::read_to_string(&file).map_err(|e| {
+            UsageError(format!(
+                "{}: {e} (give training result folders, each with curve.csv)",
+                file.display()
+            ))
+        })?;
+        let rows = hgym::train::curve::from_csv(&text).map_err(|e| UsageError(format!("{}: {e}", file.display())))?;
+        let (x, y): (Vec<f64>, Vec<f64>) = rows
+            .iter()
+            .map(|r| {
+                let y = if drag {
+                    r.eval_drag_reduction_pct
+                } else if train {
+                    r.train_return
+                } else {
+                    r.eval_return
+                };
+                (r.samples as f64, y)
+            })
+            .filter(|(_, y)| y.is_finite())
+            .unzip();
+        let label = dir
+            .components()
+            .rev()
+            .take(2)
+            .map(|c| c.as_os_str().to_string_lossy().into_owned())
+            .collect::<Vec<_>>()
+            .into_iter()
+            .rev()
+            .collect::<Vec<_>>()
+            .join("/");
+        series.push((label, x, y));
+    }
+    let lines_: Vec<Line> = series
+        .iter()
+        .map(|(l, x, y)| Line {
+            label: l,
+            x,
+            y,
+            band: None,
+        })
+        .collect();
+    let what = if drag {
+        "evaluation drag reduction (%)"
+    } else if train {
+        "training return"
+    } else {
+        "evaluation return"
+    };
+    lines(out, "learning curves", "environment samples", what, &lines_).map_err(anyhow::Error::msg)?;
+    println!("wrote {} ({} runs)", out.display(), series.len());
+    Ok(Outcome::Ok)
+}
