@@ -96,14 +96,20 @@ pub fn run(cmd: BenchCommand) -> Result<Outcome> {
         BenchCommand::Agents { json, quick, threads } => super::train::run_bench_agents(json, quick, threads),
         BenchCommand::Kolmogorov { json, quick } => {
             let b = hgym::bench::kolmogorov::bench_kolmogorov(quick);
-            if json {
-                println!("{}", serde_json::to_string_pretty(&b)?);
-            } else {
-                print!("{}", hgym::bench::kolmogorov::table(&b));
-            }
+            print_report(json, &b, &hgym::bench::kolmogorov::table(&b))?;
             Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
         }
     }
+}
+
+/// A benchmark's report as pretty JSON (`--json`) or as its table.
+fn print_report(json: bool, report: &impl serde::Serialize, table: &str) -> Result<()> {
+    if json {
+        println!("{}", serde_json::to_string_pretty(report)?);
+    } else {
+        print!("{table}");
+    }
+    Ok(())
 }
 
 fn run_bench(json: bool, quick: bool, collision: CollisionArg) -> Result<Outcome> {
@@ -128,11 +134,7 @@ fn run_bench(json: bool, quick: bool, collision: CollisionArg) -> Result<Outcome
     })
     .map_err(anyhow::Error::msg)
     .context("LBM benchmark")?;
-    if json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
-        print!("{}", report.table());
-    }
+    print_report(json, &report, &report.table())?;
     Ok(if report.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
 }
 
@@ -149,11 +151,7 @@ fn run_bench_refine(json: bool, quick: bool) -> Result<Outcome> {
     })
     .map_err(anyhow::Error::msg)
     .context("refinement benchmark")?;
-    if json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
-        print!("{}", report.table());
-    }
+    print_report(json, &report, &report.table())?;
     Ok(if report.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
 }
 
