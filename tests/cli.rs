@@ -475,12 +475,12 @@ fn envs_lists_every_id_and_show_round_trips() {
     let o = hgym(&["envs"]);
     assert!(o.status.success());
     let (out, _) = text(&o);
-    for spec in hgym::env::registry::all() {
+    for spec in hgym::env::registry::lbm_specs() {
         assert!(out.contains(&spec.id), "{} missing from `hgym envs`", spec.id);
     }
     // The deviation columns read the committed table (benchmarks/envs/fidelity.toml).
     let row = out.lines().find(|l| l.starts_with("Cylinder_2D_Re100 ")).unwrap();
-    let spec = hgym::env::spec("Cylinder_2D_Re100").unwrap();
+    let spec = hgym::env::lbm_spec("Cylinder_2D_Re100").unwrap();
     let coarse = hgym::fidelity::committed(&spec, Level::Coarse).expect("a committed coarse row");
     assert!(row.contains(&coarse.summary()), "{row}");
     let row = out.lines().find(|l| l.starts_with("Cavity_2D_Re7500 ")).unwrap();
@@ -488,7 +488,7 @@ fn envs_lists_every_id_and_show_round_trips() {
     let o = hgym(&["envs", "show", "Cylinder_2D_Re200"]);
     assert!(o.status.success());
     let shown: hgym::env::EnvSpec = toml::from_str(&text(&o).0).expect("`envs show` prints valid TOML");
-    assert_eq!(shown, hgym::env::registry::get("Cylinder_2D_Re200").unwrap());
+    assert_eq!(shown, hgym::env::registry::lbm_spec("Cylinder_2D_Re200").unwrap());
 }
 
 /// `hgym validate --env ID` runs the environment's own flow (its domain, its coarse grid) and
@@ -510,7 +510,7 @@ fn validate_env_runs_the_environment_flow_and_reports_deviations() {
         report["parameters"]["nx"], 320,
         "the environment's [0, 40] x [-10, 10] at 8 cells per D"
     );
-    let spec = hgym::env::spec("Cylinder_2D_Re100").unwrap();
+    let spec = hgym::env::lbm_spec("Cylinder_2D_Re100").unwrap();
     let committed = hgym::fidelity::committed(&spec, Level::Coarse).expect("a committed coarse row");
     assert!(stdout.contains(&committed.summary()), "{stdout}");
     // No references for the cavity: bad input, exit 2, naming the way out.

@@ -37,7 +37,7 @@ fn committed_results_were_run_on_the_registered_specs() {
         };
         let rel = f.strip_prefix(&results).unwrap().to_string_lossy().replace('\\', "/");
         let stale = STALE.iter().any(|(prefix, _)| rel.starts_with(prefix));
-        let registered = hgym::env::any::lookup(id).unwrap_or_else(|e| panic!("{rel}: {e}")).hash();
+        let registered = hgym::env::lookup(id).unwrap_or_else(|e| panic!("{rel}: {e}")).hash();
         match (registered == hash, stale) {
             (true, false) => current += 1,
             (false, true) => {}

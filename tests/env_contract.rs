@@ -12,8 +12,8 @@ use hgym_agents::{check_env, Env, EnvError};
 /// Every ID of every family (the Kolmogorov flows too) passes the checker at coarse.
 #[test]
 fn check_env_passes_over_every_spectral_id() {
-    for spec in hgym::env::any::all() {
-        if matches!(spec, hgym::env::any::AnySpec::Lbm(_)) {
+    for spec in registry::all() {
+        if spec.downcast::<hgym::env::EnvSpec>().is_some() {
             continue; // checked with more below
         }
         let mut over = toml::Table::new();
@@ -27,7 +27,7 @@ fn check_env_passes_over_every_spectral_id() {
 
 #[test]
 fn every_registered_id_keeps_the_env_contract() {
-    for mut spec in registry::all() {
+    for mut spec in registry::lbm_specs() {
         let id = spec.id.clone();
         spec.episode_actions = 4;
         let n_bodies = spec.bodies.len();
@@ -73,7 +73,7 @@ fn every_registered_id_keeps_the_env_contract() {
 /// Same seed and same actions in two separately built envs: bitwise-identical trajectories.
 #[test]
 fn same_seed_same_actions_same_trajectory() {
-    let spec = registry::get("Cylinder_2D_Re100").unwrap();
+    let spec = registry::lbm_spec("Cylinder_2D_Re100").unwrap();
     let run = || {
         let mut env = LbmEnv::new(spec.clone(), Level::Coarse, None).unwrap();
         let (mut obs, _) = env.reset(11).unwrap();
@@ -94,8 +94,8 @@ fn same_seed_same_actions_same_trajectory() {
 /// after a reset.
 #[test]
 fn gust_reaches_the_inlet_and_lifts_the_aerofoil() {
-    let steady = registry::get("NACA0012_2D_Re1000_AoA20").unwrap();
-    let mut gusty = registry::get("NACA0012Gust_2D_Re1000_AoA20").unwrap();
+    let steady = registry::lbm_spec("NACA0012_2D_Re1000_AoA20").unwrap();
+    let mut gusty = registry::lbm_spec("NACA0012Gust_2D_Re1000_AoA20").unwrap();
     assert_eq!(gusty.gust.as_ref().map(|g| g.ratio), Some(2.0), "the gust ID has a G = 2 gust");
     gusty.gust.as_mut().unwrap().start = 0.0;
     let g = gusty.gust.clone().unwrap();
@@ -154,7 +154,7 @@ fn gust_reaches_the_inlet_and_lifts_the_aerofoil() {
 /// it injects mass (a jet placed off the wall, or narrower than the grid, would inject none).
 #[test]
 fn every_independent_jet_reaches_the_wall_at_the_default_level() {
-    for spec in registry::all() {
+    for spec in registry::lbm_specs() {
         if !matches!(spec.actuation, ActuationSpec::Jets { .. }) {
             continue;
         }
@@ -179,7 +179,7 @@ fn every_independent_jet_reaches_the_wall_at_the_default_level() {
 /// temperature reached 1.168 and 0.460, see `src/env/pipe.rs`).
 #[test]
 fn stenotic_pipe_inlet_temperature_is_a_rate_limited_actuator_that_reaches_the_probes() {
-    let spec = registry::get("StenoticPipe_2D_Re100").unwrap();
+    let spec = registry::lbm_spec("StenoticPipe_2D_Re100").unwrap();
     assert_eq!(spec.obs_dim(), 40, "(u, v, p, T) at 10 probes");
     let mut env = LbmEnv::new(spec, Level::Coarse, None).unwrap();
     let mut first_probe = |a: f64| {
@@ -225,11 +225,11 @@ fn stenotic_pipe_inlet_temperature_is_a_rate_limited_actuator_that_reaches_the_p
 #[test]
 fn coarse_statistics_apply_only_where_committed() {
     use hgym::env::calibrate::level_normalization;
-    let cavity = registry::get("Cavity_2D_Re4200").unwrap();
+    let cavity = registry::lbm_spec("Cavity_2D_Re4200").unwrap();
     let coarse = level_normalization(&cavity, Level::Coarse).expect("Cavity_2D_Re4200@coarse is committed");
     assert_eq!(coarse.mean.len(), cavity.obs_dim());
     assert_ne!(coarse.mean, cavity.normalization.mean);
     assert!(level_normalization(&cavity, Level::Default).is_none());
-    let cylinder = registry::get("Cylinder_2D_Re100").unwrap();
+    let cylinder = registry::lbm_spec("Cylinder_2D_Re100").unwrap();
     assert!(level_normalization(&cylinder, Level::Coarse).is_none());
 }

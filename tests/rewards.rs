@@ -4,7 +4,7 @@
 //! started from the environment's state after `reset`; the reward is the paper's formula written
 //! out here. The `info` keys are read by name, so renaming one fails here.
 
-use hgym::env::{spec, LbmEnv};
+use hgym::env::{lbm_spec as spec, LbmEnv};
 use hgym::flow::{FlowSetup, Level};
 use hgym_agents::Env;
 

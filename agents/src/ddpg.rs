@@ -5,6 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::learn::{complete_section, decode, AlgoConfigs, Algorithm, LearnError, Learner};
 use crate::td3::{Td3, Td3Config};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -62,4 +63,33 @@ pub fn ddpg(cfg: &DdpgConfig, obs_dim: usize, act_dim: usize, seed: u64) -> Td3 
         n_envs: cfg.n_envs,
     };
     Td3::new("ddpg", t, obs_dim, act_dim, seed)
+}
+
+/// The registry entry (`--algo ddpg`, section `[ddpg]`).
+pub struct DdpgAlgorithm;
+
+impl Algorithm for DdpgAlgorithm {
+    fn name(&self) -> &'static str {
+        "ddpg"
+    }
+
+    fn about(&self) -> &'static str {
+        "deep deterministic policy gradient (Lillicrap et al. 2016), off-policy"
+    }
+
+    fn config(&self, section: Option<&serde_json::Value>) -> Result<serde_json::Value, LearnError> {
+        complete_section::<DdpgConfig>(self.name(), section)
+    }
+
+    fn n_envs(&self, cfg: &AlgoConfigs) -> Result<usize, LearnError> {
+        Ok(cfg.section::<DdpgConfig>("ddpg")?.n_envs.max(1))
+    }
+
+    fn learner(&self, cfg: &AlgoConfigs, obs_dim: usize, act_dim: usize, seed: u64) -> Result<Box<dyn Learner>, LearnError> {
+        Ok(Box::new(ddpg(&cfg.section("ddpg")?, obs_dim, act_dim, seed)))
+    }
+
+    fn decode(&self, bytes: &[u8]) -> Result<Box<dyn Learner>, LearnError> {
+        Ok(Box::new(decode::<Td3>(bytes)?))
+    }
 }

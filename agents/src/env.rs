@@ -95,3 +95,51 @@ pub trait DifferentiableEnv: Env {
     /// step `T-k+1+j`. One backward sweep over the segment.
     fn reward_action_gradients(&mut self, k: usize) -> Result<Vec<Vec<f64>>, EnvError>;
 }
+
+impl<E: Env + ?Sized> Env for Box<E> {
+    fn observation_space(&self) -> BoxSpace {
+        (**self).observation_space()
+    }
+
+    fn action_space(&self) -> BoxSpace {
+        (**self).action_space()
+    }
+
+    fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
+        (**self).reset(seed)
+    }
+
+    fn step(&mut self, action: &[f64]) -> Result<StepResult, EnvError> {
+        (**self).step(action)
+    }
+}
+
+impl<E: DifferentiableEnv + ?Sized> DifferentiableEnv for Box<E> {
+    fn reward_action_gradients(&mut self, k: usize) -> Result<Vec<Vec<f64>>, EnvError> {
+        (**self).reward_action_gradients(k)
+    }
+}
+
+impl<E: Env + ?Sized> Env for &mut E {
+    fn observation_space(&self) -> BoxSpace {
+        (**self).observation_space()
+    }
+
+    fn action_space(&self) -> BoxSpace {
+        (**self).action_space()
+    }
+
+    fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
+        (**self).reset(seed)
+    }
+
+    fn step(&mut self, action: &[f64]) -> Result<StepResult, EnvError> {
+        (**self).step(action)
+    }
+}
+
+impl<E: DifferentiableEnv + ?Sized> DifferentiableEnv for &mut E {
+    fn reward_action_gradients(&mut self, k: usize) -> Result<Vec<Vec<f64>>, EnvError> {
+        (**self).reward_action_gradients(k)
+    }
+}

@@ -14,6 +14,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::env::{DifferentiableEnv, EnvError};
+use crate::learn::{complete_section, decode, encode, AlgoConfigs, Algorithm, LearnError, Learner, ParallelEnv};
+use crate::policy::ActorPolicy;
 use crate::ppo::{Ppo, PpoConfig};
 use crate::rollout::EpisodeStats;
 
@@ -49,5 +51,70 @@ impl Gppo {
     pub fn round<E: DifferentiableEnv + Send>(&mut self, envs: &mut [E]) -> Result<Vec<EpisodeStats>, EnvError> {
         let h = self.cfg.horizon.max(1);
         self.ppo.round_with(envs, h, &|e: &mut E, k| e.reward_action_gradients(k))
+    }
+}
+
+/// The registry entry (`--algo gppo`, section `[gppo]`; its PPO hyperparameters are `[ppo]`'s).
+pub struct GppoAlgorithm;
+
+impl Algorithm for GppoAlgorithm {
+    fn name(&self) -> &'static str {
+        "gppo"
+    }
+
+    fn about(&self) -> &'static str {
+        "PPO plus the analytic reward gradient through a differentiable env (Kolmogorov flows)"
+    }
+
+    fn needs_gradients(&self) -> bool {
+        true
+    }
+
+    fn config(&self, section: Option<&serde_json::Value>) -> Result<serde_json::Value, LearnError> {
+        complete_section::<GppoConfig>(self.name(), section)
+    }
+
+    fn n_envs(&self, cfg: &AlgoConfigs) -> Result<usize, LearnError> {
+        Ok(cfg.section::<PpoConfig>("ppo")?.n_envs.max(1))
+    }
+
+    fn learner(&self, cfg: &AlgoConfigs, obs_dim: usize, act_dim: usize, seed: u64) -> Result<Box<dyn Learner>, LearnError> {
+        Ok(Box::new(Gppo::new(
+            cfg.section("ppo")?,
+            cfg.section("gppo")?,
+            obs_dim,
+            act_dim,
+            seed,
+        )))
+    }
+
+    fn decode(&self, bytes: &[u8]) -> Result<Box<dyn Learner>, LearnError> {
+        Ok(Box::new(decode::<Gppo>(bytes)?))
+    }
+}
+
+impl Learner for Gppo {
+    fn round(&mut self, envs: &mut [&mut dyn ParallelEnv]) -> Result<Vec<EpisodeStats>, EnvError> {
+        Gppo::round(self, envs)
+    }
+
+    fn policy(&self) -> ActorPolicy {
+        self.ppo.policy()
+    }
+
+    fn samples(&self) -> u64 {
+        self.ppo.samples
+    }
+
+    fn updates(&self) -> u64 {
+        self.ppo.updates
+    }
+
+    fn rounds(&self) -> u64 {
+        self.ppo.round
+    }
+
+    fn to_bytes(&self) -> Result<Vec<u8>, LearnError> {
+        encode(self)
     }
 }

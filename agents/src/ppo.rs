@@ -14,6 +14,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::env::{Env, EnvError};
+use crate::learn::{complete_section, decode, encode, AlgoConfigs, Algorithm, LearnError, Learner, ParallelEnv};
 use crate::nn::{clip_grad_norm, Activation, Adam, Init, Mlp, Tape};
 use crate::normalize::{RewardScaler, RunningMeanStd};
 use crate::policy::ActorPolicy;
@@ -416,5 +417,60 @@ fn clip_joint(a: &mut [f32], b: &mut [f32], max_norm: f64) {
     if norm > max_norm {
         let s = (max_norm / norm) as f32;
         a.iter_mut().chain(b.iter_mut()).for_each(|g| *g *= s);
+    }
+}
+
+/// The registry entry (`--algo ppo`, section `[ppo]`).
+pub struct PpoAlgorithm;
+
+impl Algorithm for PpoAlgorithm {
+    fn name(&self) -> &'static str {
+        "ppo"
+    }
+
+    fn about(&self) -> &'static str {
+        "proximal policy optimisation (Schulman et al. 2017), on-policy"
+    }
+
+    fn config(&self, section: Option<&serde_json::Value>) -> Result<serde_json::Value, LearnError> {
+        complete_section::<PpoConfig>(self.name(), section)
+    }
+
+    fn n_envs(&self, cfg: &AlgoConfigs) -> Result<usize, LearnError> {
+        Ok(cfg.section::<PpoConfig>("ppo")?.n_envs.max(1))
+    }
+
+    fn learner(&self, cfg: &AlgoConfigs, obs_dim: usize, act_dim: usize, seed: u64) -> Result<Box<dyn Learner>, LearnError> {
+        Ok(Box::new(Ppo::new(cfg.section("ppo")?, obs_dim, act_dim, seed)))
+    }
+
+    fn decode(&self, bytes: &[u8]) -> Result<Box<dyn Learner>, LearnError> {
+        Ok(Box::new(decode::<Ppo>(bytes)?))
+    }
+}
+
+impl Learner for Ppo {
+    fn round(&mut self, envs: &mut [&mut dyn ParallelEnv]) -> Result<Vec<EpisodeStats>, EnvError> {
+        Ppo::round(self, envs)
+    }
+
+    fn policy(&self) -> ActorPolicy {
+        Ppo::policy(self)
+    }
+
+    fn samples(&self) -> u64 {
+        self.samples
+    }
+
+    fn updates(&self) -> u64 {
+        self.updates
+    }
+
+    fn rounds(&self) -> u64 {
+        self.round
+    }
+
+    fn to_bytes(&self) -> Result<Vec<u8>, LearnError> {
+        encode(self)
     }
 }

@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::buffer::{Batch, ReplayBuffer};
 use crate::env::{Env, EnvError};
+use crate::learn::{complete_section, decode, encode, AlgoConfigs, Algorithm, LearnError, Learner, ParallelEnv};
 use crate::nn::{Activation, Adam, Init, Mlp, Tape};
 use crate::noise::OrnsteinUhlenbeck;
 use crate::policy::ActorPolicy;
@@ -325,5 +326,61 @@ impl Td3 {
                 c.target.soft_update(&c.net, tau);
             }
         }
+    }
+}
+
+/// The registry entry (`--algo td3`, section `[td3]`).
+pub struct Td3Algorithm;
+
+impl Algorithm for Td3Algorithm {
+    fn name(&self) -> &'static str {
+        "td3"
+    }
+
+    fn about(&self) -> &'static str {
+        "twin delayed deep deterministic policy gradient (Fujimoto et al. 2018), off-policy"
+    }
+
+    fn config(&self, section: Option<&serde_json::Value>) -> Result<serde_json::Value, LearnError> {
+        complete_section::<Td3Config>(self.name(), section)
+    }
+
+    fn n_envs(&self, cfg: &AlgoConfigs) -> Result<usize, LearnError> {
+        Ok(cfg.section::<Td3Config>("td3")?.n_envs.max(1))
+    }
+
+    fn learner(&self, cfg: &AlgoConfigs, obs_dim: usize, act_dim: usize, seed: u64) -> Result<Box<dyn Learner>, LearnError> {
+        Ok(Box::new(Td3::new("td3", cfg.section("td3")?, obs_dim, act_dim, seed)))
+    }
+
+    fn decode(&self, bytes: &[u8]) -> Result<Box<dyn Learner>, LearnError> {
+        Ok(Box::new(decode::<Td3>(bytes)?))
+    }
+}
+
+/// TD3 and DDPG (a TD3 with its additions switched off) share this learner.
+impl Learner for Td3 {
+    fn round(&mut self, envs: &mut [&mut dyn ParallelEnv]) -> Result<Vec<EpisodeStats>, EnvError> {
+        Td3::round(self, envs)
+    }
+
+    fn policy(&self) -> ActorPolicy {
+        Td3::policy(self)
+    }
+
+    fn samples(&self) -> u64 {
+        self.samples
+    }
+
+    fn updates(&self) -> u64 {
+        self.updates
+    }
+
+    fn rounds(&self) -> u64 {
+        self.round
+    }
+
+    fn to_bytes(&self) -> Result<Vec<u8>, LearnError> {
+        encode(self)
     }
 }

@@ -23,7 +23,7 @@ pub struct EnvBenchRow {
 
 /// The lattice-Boltzmann families `bench_envs` can time, sorted.
 pub fn families() -> Vec<String> {
-    let set: std::collections::BTreeSet<String> = registry::all().into_iter().map(|s| s.family).collect();
+    let set: std::collections::BTreeSet<String> = registry::lbm_specs().into_iter().map(|s| s.family).collect();
     set.into_iter().collect()
 }
 
@@ -38,7 +38,7 @@ pub fn bench_envs(
 ) -> Result<Vec<EnvBenchRow>, String> {
     let mut seen = std::collections::BTreeSet::new();
     let mut rows = Vec::new();
-    for spec in registry::all() {
+    for spec in registry::lbm_specs() {
         if !families.is_empty() && !families.contains(&spec.family) {
             continue;
         }

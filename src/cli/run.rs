@@ -49,15 +49,16 @@ pub fn run(args: RunArgs) -> Result<Outcome> {
         }
     };
     let spec = match hgym::train::resolve_spec(&args.env, &config) {
-        Ok(hgym::env::any::AnySpec::Lbm(s)) => s,
-        Ok(other) => {
-            return Err(UsageError(format!(
-                "`hgym run` draws lattice-Boltzmann flows; for {} use `hgym eval --policy zero|random|sine --env {}`",
-                other.id(),
-                other.id()
+        Ok(s) => match s.downcast::<hgym::env::EnvSpec>() {
+            Some(s) => s.clone(),
+            None => return Err(UsageError(format!(
+                "`hgym run` draws lattice-Boltzmann flows; {} runs on the {} solver: use `hgym eval --policy zero|random|sine --env {}`",
+                s.id(),
+                s.solver(),
+                s.id()
             ))
-            .into())
-        }
+            .into()),
+        },
         Err(hgym::train::TrainError::Input(m)) => return Err(UsageError(m).into()),
         Err(e) => return Err(e.into()),
     };

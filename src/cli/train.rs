@@ -10,30 +10,19 @@ use hgym::train::config::TrainConfig;
 use hgym::train::eval::{evaluate, parse_policy, uncontrolled_c_d, EvalReport, NamedPolicy};
 use hgym::train::{resolve_spec, resume_options, summarize, Ending, TrainError, TrainOptions};
 use hgym_agents::baselines::BaselinePolicy;
-use hgym_agents::learn::Algo;
+use hgym_agents::learn::{algorithm, ALGORITHMS};
 use hgym_agents::policy::Policy;
 
 use crate::cli::progress::progress_bar;
 use crate::{thread_pool, Outcome, UsageError};
 
-#[derive(Clone, Copy, clap::ValueEnum)]
-pub enum AlgoArg {
-    Ppo,
-    Ddpg,
-    Td3,
-    /// PPO plus the analytic reward gradient through a differentiable env (Kolmogorov flows).
-    Gppo,
-}
-
-impl From<AlgoArg> for Algo {
-    fn from(a: AlgoArg) -> Algo {
-        match a {
-            AlgoArg::Ppo => Algo::Ppo,
-            AlgoArg::Ddpg => Algo::Ddpg,
-            AlgoArg::Td3 => Algo::Td3,
-            AlgoArg::Gppo => Algo::Gppo,
-        }
-    }
+/// `--algo`: the registered algorithms, each with its one-line description.
+fn algo_names() -> clap::builder::PossibleValuesParser {
+    clap::builder::PossibleValuesParser::new(
+        ALGORITHMS
+            .iter()
+            .map(|a| clap::builder::PossibleValue::new(a.name()).help(a.about())),
+    )
 }
 
 #[derive(Args)]
@@ -42,8 +31,8 @@ pub struct TrainArgs {
     #[arg(long, required_unless_present_any = ["resume", "print_config"])]
     env: Option<String>,
     /// Learning algorithm.
-    #[arg(long, value_enum, default_value = "td3")]
-    algo: AlgoArg,
+    #[arg(long, default_value = "td3", value_parser = algo_names())]
+    algo: String,
     /// Seed of the learner and of every episode's initial phase.
     #[arg(long, default_value_t = 0, conflicts_with = "seeds")]
     seed: u64,
@@ -175,7 +164,7 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
         eprintln!(
             "resuming {} {} seed {} at {} samples (round {})",
             opts.env_id,
-            opts.algo.name(),
+            opts.algo,
             opts.seed,
             ck.curve.last().map(|r| r.samples).unwrap_or(0),
             ck.curve.len()
@@ -183,12 +172,13 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
         vec![(opts, Some(ck))]
     } else {
         let env_id = args.env.clone().unwrap_or_default();
-        let algo: Algo = args.algo.into();
+        let algo = algorithm(&args.algo).map_err(|e| UsageError(e.to_string()))?;
         let spec = resolve_spec(&env_id, &config).map_err(train_error)?;
-        if algo == Algo::Gppo && !spec.differentiable() {
+        if algo.needs_gradients() && !spec.differentiable() {
             return Err(UsageError(format!(
-                "gppo needs a differentiable environment (the Kolmogorov flows, e.g. Kolmogorov_2D_Re40); \
+                "{} needs a differentiable environment (the Kolmogorov flows, e.g. Kolmogorov_2D_Re40); \
                  {env_id} runs on the {} solver, which has no adjoint: use ppo, ddpg or td3",
+                algo.name(),
                 spec.solver()
             ))
             .into());
@@ -204,7 +194,7 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
                 (
                     TrainOptions {
                         env_id: env_id.clone(),
-                        algo,
+                        algo: algo.name().to_string(),
                         seed: *s,
                         level: args.level,
                         config: config.clone(),
@@ -218,7 +208,7 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
     };
     let mut finished = vec![];
     for (opts, ck) in jobs {
-        let label = format!("{} s{}", opts.algo.name(), opts.seed);
+        let label = format!("{} s{}", opts.algo, opts.seed);
         let pb = progress_bar(opts.config.train.steps, &label);
         if let Some(ck) = &ck {
             pb.set_position(ck.curve.last().map(|r| r.samples).unwrap_or(0));
@@ -260,7 +250,7 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
                 )
             })
             .map_err(train_error)
-            .with_context(|| format!("training {} on {}", opts.algo.name(), opts.env_id))?;
+            .with_context(|| format!("training {} on {}", opts.algo, opts.env_id))?;
         pb.finish_and_clear();
         match ending {
             Ending::Interrupted { samples } => {
@@ -275,7 +265,7 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
                     println!(
                         "{} {} seed {}: return {:.3} +- {:.3} over {} episodes\n  results: {}",
                         opts.env_id,
-                        opts.algo.name(),
+                        opts.algo,
                         opts.seed,
                         report.ret.mean,
                         report.ret.std,
@@ -286,7 +276,7 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
                     println!(
                         "{} {} seed {}: drag reduction {:+.2} % +- {:.2} (C_D {:.4} vs {:.4} uncontrolled), return {:.2} +- {:.2} over {} episodes",
                         opts.env_id,
-                        opts.algo.name(),
+                        opts.algo,
                         opts.seed,
                         report.drag_reduction_pct.mean,
                         report.drag_reduction_pct.std,
@@ -305,7 +295,7 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
     if finished.len() > 1 {
         let o = &finished[0].3;
         let runs: Vec<_> = finished.iter().map(|(s, p, r, _)| (*s, p.clone(), r.clone())).collect();
-        let summary = summarize(&o.env_id, o.algo.name(), o.level.name(), &runs);
+        let summary = summarize(&o.env_id, &o.algo, o.level.name(), &runs);
         let root = o.out.parent().unwrap_or(Path::new("."));
         std::fs::write(root.join("summary.json"), serde_json::to_string_pretty(&summary)? + "\n")
             .with_context(|| format!("cannot write {}", root.join("summary.json").display()))?;
@@ -379,7 +369,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
                 hgym::data::trajectory::TrajectoryWriter::create(
                     &dir.join("trajectory.mcap"),
                     spec.control_interval(),
-                    spec.trajectory_manifest(args.level, &args.policy, &seeds),
+                    spec.trajectory_manifest(args.level, &args.policy, &seeds)?,
                 )
                 .map_err(anyhow::Error::msg)?
                 .with_fields(args.fields_every),
@@ -505,13 +495,15 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
     use hgym::train::compare::{analyse, uncontrolled_return, Protocol};
     let p = Protocol::load(&args.protocol).map_err(UsageError)?;
     let spec = resolve_spec(&p.env, &p.config).map_err(train_error)?;
-    if p.algos.contains(&Algo::Gppo) && !spec.differentiable() {
-        return Err(UsageError(format!(
-            "{}: gppo needs a differentiable environment, {} is not",
-            args.protocol.display(),
-            p.env
-        ))
-        .into());
+    for name in &p.algos {
+        if algorithm(name).is_ok_and(|a| a.needs_gradients()) && !spec.differentiable() {
+            return Err(UsageError(format!(
+                "{}: {name} needs a differentiable environment, {} is not",
+                args.protocol.display(),
+                p.env
+            ))
+            .into());
+        }
     }
     let root = args.out.join(&p.name);
     let (pool, _) = thread_pool(args.threads)?;
@@ -519,9 +511,9 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
     if !args.analyse_only {
         for algo in &p.algos {
             for seed in &p.seeds {
-                let dir = root.join(algo.name()).join(format!("seed{seed}"));
+                let dir = root.join(algo).join(format!("seed{seed}"));
                 if dir.join("metrics.json").exists() {
-                    eprintln!("{} seed {seed}: done already ({})", algo.name(), dir.display());
+                    eprintln!("{} seed {seed}: done already ({})", algo, dir.display());
                     continue;
                 }
                 let resume = if dir.join(hgym::train::checkpoint::FILE).exists() {
@@ -531,14 +523,14 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
                 };
                 let opts = TrainOptions {
                     env_id: p.env.clone(),
-                    algo: *algo,
+                    algo: algo.clone(),
                     seed: *seed,
                     level: p.level,
                     config: p.config.clone(),
                     out: dir.clone(),
                     cache: hgym::env::default_cache_dir(),
                 };
-                let label = format!("{} s{seed}", algo.name());
+                let label = format!("{algo} s{seed}");
                 let pb = progress_bar(p.config.train.steps, &label);
                 let ending = pool
                     .install(|| {
@@ -560,7 +552,7 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
                     eprintln!("stopped; run the same command again to continue where it stopped");
                     std::process::exit(130);
                 }
-                eprintln!("{} seed {seed}: finished ({})", algo.name(), dir.display());
+                eprintln!("{} seed {seed}: finished ({})", algo, dir.display());
             }
         }
     }
@@ -578,7 +570,7 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
             p.level.name(),
             p.seeds,
             cmp.uncontrolled_return,
-            p.reference.name(),
+            p.reference,
             cmp.reference_final_return,
             cmp.threshold
         );
@@ -596,7 +588,7 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
             );
         }
         for (a, r) in &cmp.sample_reduction_vs_reference {
-            println!("  {a} needs {:+.1} % samples vs {}", -100.0 * r, p.reference.name());
+            println!("  {a} needs {:+.1} % samples vs {}", -100.0 * r, p.reference);
         }
         println!("  results: {}", root.display());
     }

@@ -155,9 +155,12 @@ fn run_cases(cases: &[LoadedCase], args: &ValidateArgs, out: &std::path::Path) -
 /// references, each distinct flow run once and its row recorded for every ID that shares it.
 fn run_envs(args: &ValidateArgs) -> Result<Outcome> {
     let specs = if args.envs.iter().any(|e| e == "all") {
-        hgym::env::registry::all().into_iter().filter(fidelity::has_reference).collect()
+        hgym::env::registry::lbm_specs()
+            .into_iter()
+            .filter(fidelity::has_reference)
+            .collect()
     } else {
-        args.envs.iter().map(|id| hgym::env::spec(id)).collect::<Result<Vec<_>, _>>()?
+        args.envs.iter().map(|id| hgym::env::lbm_spec(id)).collect::<Result<Vec<_>, _>>()?
     };
     let mut flows: Vec<(String, Vec<&hgym::env::EnvSpec>)> = Vec::new();
     for s in &specs {

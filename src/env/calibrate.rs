@@ -13,6 +13,9 @@ use crate::flow::Level;
 /// The committed table, as text (embedded at build time).
 pub const TABLE: &str = include_str!("../../benchmarks/envs/normalization.toml");
 
+/// Where [`TABLE`] lives, from the repository root.
+pub const TABLE_PATH: &str = "benchmarks/envs/normalization.toml";
+
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Entry {

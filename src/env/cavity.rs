@@ -51,6 +51,15 @@ use crate::flow::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, Resoluti
 
 pub const REYNOLDS: [u32; 2] = [4200, 7500];
 
+/// The open cavity family: the plain cavity and the three-jet cavity.
+pub struct Cavity;
+
+impl super::family::Family for Cavity {
+    fn specs(&self) -> Vec<super::family::Spec> {
+        super::registry::lbm(specs())
+    }
+}
+
 /// The upstream lip of the cavity, its length and depth.
 pub const LEADING_EDGE: [f64; 2] = [0.27, 1.0];
 pub const LENGTH: f64 = 1.0;

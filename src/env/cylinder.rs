@@ -19,6 +19,15 @@ use crate::flow::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, Resoluti
 /// The Reynolds numbers of the family.
 pub const REYNOLDS: [u32; 4] = [100, 200, 1000, 3900];
 
+/// The circular cylinder family: jets, then rotation, each over [`REYNOLDS`].
+pub struct Cylinder;
+
+impl super::family::Family for Cylinder {
+    fn specs(&self) -> Vec<super::family::Spec> {
+        super::registry::lbm(REYNOLDS.map(jets).into_iter().chain(REYNOLDS.map(rotary)))
+    }
+}
+
 /// The paper's lift weight `w` of the bluff-body reward at `re` (cylinder and square cylinder).
 fn lift_weight(re: u32) -> f64 {
     match re {

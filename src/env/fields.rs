@@ -5,7 +5,6 @@
 //! the periodic square `[0, 2 pi]^2`.
 
 use crate::data::field::Snapshot;
-use crate::env::any::AnyEnv;
 use crate::env::LbmEnv;
 use crate::flow::vorticity_field;
 
@@ -69,11 +68,8 @@ impl FlowFields for crate::env::kolmogorov::KolmogorovEnv {
     }
 }
 
-impl FlowFields for AnyEnv {
+impl<E: FlowFields + ?Sized> FlowFields for Box<E> {
     fn snapshot(&mut self) -> Snapshot {
-        match self {
-            AnyEnv::Lbm(e) => e.snapshot(),
-            AnyEnv::Kolmogorov(e) => e.snapshot(),
-        }
+        (**self).snapshot()
     }
 }

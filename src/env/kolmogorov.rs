@@ -21,6 +21,7 @@
 //!   states with the solver's step VJP.
 
 use std::collections::HashMap;
+use std::path::{Path, PathBuf};
 use std::sync::{Mutex, OnceLock};
 
 use hgym_agents::{checked_action, BoxSpace, DifferentiableEnv, Env, EnvError, Info, StepResult};
@@ -28,7 +29,9 @@ use hgym_solvers::spectral::{Complex64 as C, Kolmogorov, KolmogorovConfig};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use super::family::{merged, CalibrateError, Family, FamilySpec, FlowEnv, Spec};
 use super::seeding::splitmix64;
+use super::EnvInputError;
 use crate::flow::{Level, ResolutionSpec};
 
 pub const REYNOLDS: [u32; 3] = [40, 100, 200];
@@ -132,6 +135,111 @@ impl KolmogorovSpec {
 
 /// The committed statistics table.
 pub const TABLE: &str = include_str!("../../benchmarks/envs/kolmogorov.toml");
+
+/// Where [`TABLE`] lives, from the repository root.
+pub const TABLE_PATH: &str = "benchmarks/envs/kolmogorov.toml";
+
+/// The Kolmogorov flows over [`REYNOLDS`].
+pub struct KolmogorovFlows;
+
+impl Family for KolmogorovFlows {
+    fn specs(&self) -> Vec<Spec> {
+        all().into_iter().map(Spec::new).collect()
+    }
+}
+
+impl FamilySpec for KolmogorovSpec {
+    fn id(&self) -> &str {
+        &self.id
+    }
+
+    fn family(&self) -> &str {
+        &self.family
+    }
+
+    fn reynolds(&self) -> f64 {
+        self.reynolds
+    }
+
+    fn solver(&self) -> &'static str {
+        "spectral"
+    }
+
+    fn obs_dim(&self) -> usize {
+        KolmogorovSpec::obs_dim(self)
+    }
+
+    fn act_dim(&self) -> usize {
+        KolmogorovSpec::act_dim(self)
+    }
+
+    fn control_interval(&self) -> f64 {
+        self.control_interval
+    }
+
+    fn differentiable(&self) -> bool {
+        true
+    }
+
+    fn calibrated(&self) -> bool {
+        self.statistics.u_rms > 0.0
+    }
+
+    fn hash(&self) -> String {
+        KolmogorovSpec::hash(self)
+    }
+
+    fn to_json(&self) -> Result<serde_json::Value, serde_json::Error> {
+        serde_json::to_value(self)
+    }
+
+    fn to_toml(&self) -> String {
+        KolmogorovSpec::to_toml(self)
+    }
+
+    fn with_overrides(&self, over: &toml::Table) -> Result<Spec, EnvInputError> {
+        Ok(Spec::new(merged(self, over, &self.id)?))
+    }
+
+    fn make(&self, level: Level, _cache: Option<PathBuf>) -> Result<Box<dyn FlowEnv>, EnvError> {
+        Ok(Box::new(KolmogorovEnv::new(self.clone(), level)?))
+    }
+
+    /// Records the flow statistics under the ID (the table holds one level per ID).
+    fn calibrate(
+        &self,
+        level: Level,
+        actions: usize,
+        _cache: Option<PathBuf>,
+        table: Option<&Path>,
+        progress: &mut dyn FnMut(usize),
+    ) -> Result<(String, PathBuf), CalibrateError> {
+        if actions == 0 {
+            return Err(CalibrateError::NoActions);
+        }
+        let table = table.map_or_else(|| PathBuf::from(TABLE_PATH), Path::to_path_buf);
+        if let Ok(text) = std::fs::read_to_string(&table) {
+            crate::report::table::parse::<FlowStatistics>(&text, &table)?;
+        }
+        let st = calibrate(self, level, actions, progress)?;
+        let summary = format!(
+            "{}: u_rms {:.4}, dissipation {:.4} +- {:.4} (laminar {:.4}), TKE {:.4} over {} time units",
+            self.id,
+            st.u_rms,
+            st.dissipation_mean,
+            st.dissipation_std,
+            self.dissipation_laminar(),
+            st.tke_mean,
+            st.time
+        );
+        crate::report::table::record(&table, &[(self.id.clone(), st)])?;
+        Ok((summary, table))
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
 
 pub fn spec(re: u32) -> KolmogorovSpec {
     let mut s = KolmogorovSpec {

@@ -17,15 +17,17 @@
 //!   with `inflow` the west velocity oscillates (its phase continues from the spin-up, so the
 //!   seed-dependent start also picks the phase of the oscillation).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use hgym_agents::{checked_action, BoxSpace, Env, EnvError, Info, StepResult};
 use hgym_solvers::lbm::thermal::{Thermal, ThermalSide};
 use hgym_solvers::lbm::{D2q9, Edge, LbmError, Side, Units};
 
 use super::actuation::{apply, Jet, WallMotion};
+use super::family::{merged, CalibrateError, FamilySpec, FlowEnv, Spec};
 use super::seeding::splitmix64;
 use super::spec::{ActuationSpec, EnvSpec, RewardSpec};
+use super::EnvInputError;
 use crate::flow::{FlowError, GeometrySpec, LbmFlow, Level};
 
 pub struct LbmEnv {
@@ -614,5 +616,103 @@ pub fn reward(spec: &RewardSpec, forces: &IntervalForces, obs: &[f64], probe_tem
             c_d_ref,
             drag_weight,
         } => -(c_l - c_l_ref).abs() - drag_weight * (c_d - c_d_ref).abs(),
+    }
+}
+
+impl hgym_agents::DifferentiableEnv for LbmEnv {
+    fn reward_action_gradients(&mut self, _k: usize) -> Result<Vec<Vec<f64>>, EnvError> {
+        Err(EnvError::Backend(format!(
+            "{} is not differentiable (only the spectral Kolmogorov flows are); use ppo, ddpg or td3",
+            self.spec.id
+        )))
+    }
+}
+
+/// The 2D lattice-Boltzmann families (cylinder, pinball, square, cavity, NACA 0012, pipe) share
+/// this spec type and [`LbmEnv`].
+impl FamilySpec for EnvSpec {
+    fn id(&self) -> &str {
+        &self.id
+    }
+
+    fn family(&self) -> &str {
+        &self.family
+    }
+
+    fn reynolds(&self) -> f64 {
+        self.reynolds
+    }
+
+    fn solver(&self) -> &'static str {
+        if self.thermal.is_some() {
+            "lbm-d2q9+q5"
+        } else {
+            "lbm-d2q9"
+        }
+    }
+
+    fn obs_dim(&self) -> usize {
+        EnvSpec::obs_dim(self)
+    }
+
+    fn act_dim(&self) -> usize {
+        EnvSpec::act_dim(self)
+    }
+
+    fn control_interval(&self) -> f64 {
+        self.control_interval
+    }
+
+    fn calibrated(&self) -> bool {
+        !self.normalization.mean.is_empty()
+    }
+
+    fn hash(&self) -> String {
+        EnvSpec::hash(self)
+    }
+
+    fn to_json(&self) -> Result<serde_json::Value, serde_json::Error> {
+        serde_json::to_value(self)
+    }
+
+    fn to_toml(&self) -> String {
+        EnvSpec::to_toml(self)
+    }
+
+    fn with_overrides(&self, over: &toml::Table) -> Result<Spec, EnvInputError> {
+        Ok(Spec::new(merged(self, over, &self.id)?))
+    }
+
+    fn make(&self, level: Level, cache: Option<PathBuf>) -> Result<Box<dyn FlowEnv>, EnvError> {
+        Ok(Box::new(LbmEnv::new(self.clone(), level, cache)?))
+    }
+
+    fn calibrate(
+        &self,
+        level: Level,
+        actions: usize,
+        cache: Option<PathBuf>,
+        table: Option<&Path>,
+        progress: &mut dyn FnMut(usize),
+    ) -> Result<(String, PathBuf), CalibrateError> {
+        if actions == 0 {
+            return Err(CalibrateError::NoActions);
+        }
+        let table = table.map_or_else(|| PathBuf::from(super::calibrate::TABLE_PATH), Path::to_path_buf);
+        // Fail before the run on a table that cannot be read back.
+        if let Ok(text) = std::fs::read_to_string(&table) {
+            crate::report::table::parse::<super::calibrate::Entry>(&text, &table)?;
+        }
+        let entry = super::calibrate::calibrate(self, level, actions, cache, &mut |k, _| progress(k))?;
+        let summary = match entry.mean_forces {
+            Some([c_d, c_l]) => format!("{}: uncontrolled mean C_D {c_d:.4}, mean C_L {c_l:.4}", self.id),
+            None => format!("{}: calibrated", self.id),
+        };
+        crate::report::table::record(&table, &[(super::calibrate::table_key(&self.id, level), entry)])?;
+        Ok((summary, table))
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }

@@ -1,17 +1,19 @@
 //! Flow environments: where solvers (`hgym-solvers`) meet the `Env` contract (`hgym-agents`).
 //!
-//! - [`spec`]: the serialisable description of an environment (its hash keys caches and results);
-//! - [`registry`]: every ID; [`cylinder`], [`pinball`], [`square`], [`cavity`], [`naca`],
-//!   [`pipe`]: the families' specs;
-//! - [`lbm_env`]: the `Env` implementation for 2D lattice-Boltzmann families;
+//! - [`family`]: the trait a family implements, the spec and environment types everything else
+//!   sees ([`family::Spec`], [`family::FlowEnv`]);
+//! - [`registry`]: the list of families and the lookup; [`cylinder`], [`pinball`], [`square`],
+//!   [`cavity`], [`naca`], [`pipe`] (lattice Boltzmann), [`kolmogorov`] (spectral): one file each;
+//! - [`spec`]: the serialisable description of a lattice-Boltzmann environment (its hash keys
+//!   caches and results); [`lbm_env`]: its `Env` implementation;
 //! - [`actuation`]: jets, rotation, and the temporal smoothing of actions;
 //! - [`spin_up`]: progress reports of the first reset's spin-up, to an observer the program installs.
 
 pub mod actuation;
-pub mod any;
 pub mod calibrate;
 pub mod cavity;
 pub mod cylinder;
+pub mod family;
 pub mod fields;
 pub mod kolmogorov;
 pub mod lbm_env;
@@ -25,7 +27,9 @@ pub mod spec;
 pub mod spin_up;
 pub mod square;
 
+pub use family::{FlowEnv, Spec};
 pub use lbm_env::LbmEnv;
+pub use registry::{lbm_spec, lookup};
 pub use spec::EnvSpec;
 
 /// Errors of the environment commands that are the user's input (exit code 2).
@@ -33,14 +37,10 @@ pub use spec::EnvSpec;
 pub enum EnvInputError {
     #[error("unknown environment ID '{id}'; did you mean {}? (`hgym envs` lists all)", closest.iter().take(3).map(|s| format!("'{s}'")).collect::<Vec<_>>().join(", "))]
     UnknownEnv { id: String, closest: Vec<String> },
-}
-
-/// The spec of `id`, or an error that names the closest IDs.
-pub fn spec(id: &str) -> Result<EnvSpec, EnvInputError> {
-    registry::get(id).map_err(|closest| EnvInputError::UnknownEnv {
-        id: id.to_string(),
-        closest,
-    })
+    #[error("{id} runs on the {solver} solver; this command needs a lattice-Boltzmann flow (`hgym envs` lists the solver of each ID)")]
+    NotLbm { id: String, solver: &'static str },
+    #[error("[env] overrides of {id}: {message}")]
+    Override { id: String, message: String },
 }
 
 /// Where developed-flow states are cached: `$HGYM_CACHE`, else `~/.cache/hgym/states`.

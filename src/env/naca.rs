@@ -38,6 +38,20 @@ use super::spec::{probe_grid, ActuationSpec, EnvSpec, GustSpec, RewardSpec};
 use crate::flow::{DomainSpec, GeometrySpec, ResolutionSpec};
 
 pub const REYNOLDS: [u32; 2] = [100, 1000];
+
+/// The NACA 0012 family: steady inflow at every Re and angle, then the gusts.
+pub struct Naca;
+
+impl super::family::Family for Naca {
+    fn specs(&self) -> Vec<super::family::Spec> {
+        super::registry::lbm(
+            REYNOLDS
+                .iter()
+                .flat_map(|&re| ANGLES.map(|aoa| steady(re, aoa)))
+                .chain(REYNOLDS.iter().flat_map(|&re| ANGLES.iter().filter_map(move |&aoa| gust(re, aoa)))),
+        )
+    }
+}
 pub const ANGLES: [u32; 2] = [20, 40];
 
 pub const LEADING_EDGE: [f64; 2] = [6.5, 0.0];

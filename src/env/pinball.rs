@@ -21,6 +21,15 @@ use crate::flow::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, Resoluti
 
 pub const REYNOLDS: [u32; 4] = [30, 75, 100, 150];
 
+/// The fluidic pinball family: rotation, then jets, each over [`REYNOLDS`].
+pub struct Pinball;
+
+impl super::family::Family for Pinball {
+    fn specs(&self) -> Vec<super::family::Spec> {
+        super::registry::lbm(REYNOLDS.map(rotary).into_iter().chain(REYNOLDS.map(jets)))
+    }
+}
+
 /// Centre of the pinball (the triangle's reference point).
 pub const CENTER: [f64; 2] = [10.0, 0.0];
 

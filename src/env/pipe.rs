@@ -52,6 +52,15 @@ use crate::flow::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, Resoluti
 
 pub const REYNOLDS: [u32; 1] = [100];
 
+/// The stenotic pipe family over [`REYNOLDS`].
+pub struct Pipe;
+
+impl super::family::Family for Pipe {
+    fn specs(&self) -> Vec<super::family::Spec> {
+        super::registry::lbm(REYNOLDS.map(stenotic_pipe))
+    }
+}
+
 /// The probes: the centreline from x = -3.5 to x = 1; the last one is the reward's.
 fn probes() -> Vec<[f64; 2]> {
     (0..10).map(|k| [-3.5 + 0.5 * k as f64, 0.0]).collect()

@@ -1,65 +1,67 @@
-//! Every environment ID and its spec.
+//! Every environment ID: the list of families, one line each, and the lookup.
 
-use super::calibrate;
-use super::cavity;
-use super::cylinder;
-use super::naca;
-use super::pinball;
-use super::pipe;
+use super::family::{Family, Spec};
 use super::spec::EnvSpec;
-use super::square;
+use super::{calibrate, cavity, cylinder, kolmogorov, naca, pinball, pipe, square, EnvInputError};
 
-/// All registered specs, in a fixed order, with their committed observation statistics.
-pub fn all() -> Vec<EnvSpec> {
-    let mut v = Vec::new();
-    for re in cylinder::REYNOLDS {
-        v.push(cylinder::jets(re));
-    }
-    for re in cylinder::REYNOLDS {
-        v.push(cylinder::rotary(re));
-    }
-    for re in pinball::REYNOLDS {
-        v.push(pinball::rotary(re));
-    }
-    for re in pinball::REYNOLDS {
-        v.push(pinball::jets(re));
-    }
-    for re in square::REYNOLDS {
-        v.push(square::square(re));
-    }
-    v.extend(cavity::specs());
-    for re in naca::REYNOLDS {
-        for aoa in naca::ANGLES {
-            v.push(naca::steady(re, aoa));
-        }
-    }
-    for re in naca::REYNOLDS {
-        for aoa in naca::ANGLES {
-            v.extend(naca::gust(re, aoa));
-        }
-    }
-    for re in pipe::REYNOLDS {
-        v.push(pipe::stenotic_pipe(re));
-    }
-    // The table is checked by a test; a broken one only means uncalibrated observations.
-    for s in &mut v {
-        calibrate::attach(s, calibrate::table());
-    }
-    v
+/// The families, in listing order. A new family is one file implementing [`Family`] and one
+/// line here.
+pub const FAMILIES: &[&dyn Family] = &[
+    &cylinder::Cylinder,
+    &pinball::Pinball,
+    &square::Square,
+    &cavity::Cavity,
+    &naca::Naca,
+    &pipe::Pipe,
+    &kolmogorov::KolmogorovFlows,
+];
+
+/// All registered specs, in a fixed order, with their committed statistics.
+pub fn all() -> Vec<Spec> {
+    FAMILIES.iter().flat_map(|f| f.specs()).collect()
 }
 
-/// The spec of `id`, or the list of IDs (closest first) to put in the error.
-pub fn get(id: &str) -> Result<EnvSpec, Vec<String>> {
+/// The spec of `id`, or an error naming the closest IDs.
+pub fn lookup(id: &str) -> Result<Spec, EnvInputError> {
     let specs = all();
-    if let Some(s) = specs.iter().find(|s| s.id == id) {
+    if let Some(s) = specs.iter().find(|s| s.id() == id) {
         return Ok(s.clone());
     }
     let mut ids: Vec<(usize, String)> = specs
-        .into_iter()
-        .map(|s| (edit_distance(&s.id.to_lowercase(), &id.to_lowercase()), s.id))
+        .iter()
+        .map(|s| (edit_distance(&s.id().to_lowercase(), &id.to_lowercase()), s.id().to_string()))
         .collect();
     ids.sort();
-    Err(ids.into_iter().map(|(_, id)| id).collect())
+    Err(EnvInputError::UnknownEnv {
+        id: id.to_string(),
+        closest: ids.into_iter().map(|(_, id)| id).collect(),
+    })
+}
+
+/// The lattice-Boltzmann specs among all (those the flow layer builds).
+pub fn lbm_specs() -> Vec<EnvSpec> {
+    all().iter().filter_map(|s| s.downcast::<EnvSpec>().cloned()).collect()
+}
+
+/// The lattice-Boltzmann spec of `id` (an error for an unknown ID or another solver's).
+pub fn lbm_spec(id: &str) -> Result<EnvSpec, EnvInputError> {
+    let spec = lookup(id)?;
+    spec.downcast::<EnvSpec>().cloned().ok_or_else(|| EnvInputError::NotLbm {
+        id: id.to_string(),
+        solver: spec.solver(),
+    })
+}
+
+/// Lattice-Boltzmann specs as registry entries, with the committed observation statistics
+/// attached (a family's `specs`).
+pub(super) fn lbm(specs: impl IntoIterator<Item = EnvSpec>) -> Vec<Spec> {
+    specs
+        .into_iter()
+        .map(|mut s| {
+            calibrate::attach(&mut s, calibrate::table());
+            Spec::new(s)
+        })
+        .collect()
 }
 
 /// Levenshtein distance (for "did you mean").
@@ -83,13 +85,24 @@ mod tests {
     #[test]
     fn ids_are_unique_and_found() {
         let specs = all();
-        let mut ids: Vec<&str> = specs.iter().map(|s| s.id.as_str()).collect();
+        let mut ids: Vec<&str> = specs.iter().map(|s| s.id()).collect();
         ids.sort();
         ids.dedup();
         assert_eq!(ids.len(), specs.len());
-        assert!(get("Cylinder_2D_Re100").is_ok());
-        let err = get("Cylinder_2D_Re10").unwrap_err();
-        assert_eq!(err[0], "Cylinder_2D_Re100");
+        assert!(lookup("Cylinder_2D_Re100").is_ok());
+        assert!(lookup("Kolmogorov_2D_Re40").is_ok());
+        let EnvInputError::UnknownEnv { closest, .. } = lookup("Cylinder_2D_Re10").unwrap_err() else {
+            panic!("not an unknown-ID error")
+        };
+        assert_eq!(closest[0], "Cylinder_2D_Re100");
+        assert!(matches!(lbm_spec("Kolmogorov_2D_Re40"), Err(EnvInputError::NotLbm { .. })));
+    }
+
+    #[test]
+    fn every_family_registers_ids() {
+        for f in FAMILIES {
+            assert!(!f.specs().is_empty());
+        }
     }
 
     #[test]

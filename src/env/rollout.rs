@@ -95,14 +95,12 @@ pub fn rollout(
     let mut env = LbmEnv::new(spec_run, opts.level, opts.cache.clone())?;
     let (obs0, info0) = env.reset(opts.seed)?;
     std::fs::create_dir_all(&opts.out).map_err(|e| EnvError::Backend(format!("cannot create {}: {e}", opts.out.display())))?;
-    let any = crate::env::any::AnySpec::Lbm(spec.clone());
     let policy_name = format!("{:?}", opts.policy).to_lowercase();
-    let trajectory = crate::data::trajectory::TrajectoryWriter::create(
-        &opts.out.join("trajectory.mcap"),
-        spec.control_interval,
-        any.trajectory_manifest(opts.level, &policy_name, &[opts.seed]),
-    )
-    .map_err(EnvError::Backend)?;
+    let metadata = crate::env::Spec::new(spec.clone())
+        .trajectory_manifest(opts.level, &policy_name, &[opts.seed])
+        .map_err(|e| EnvError::Backend(format!("cannot describe the spec: {e}")))?;
+    let trajectory = crate::data::trajectory::TrajectoryWriter::create(&opts.out.join("trajectory.mcap"), spec.control_interval, metadata)
+        .map_err(EnvError::Backend)?;
     let mut trajectory = trajectory.with_fields(opts.fields_every);
     trajectory.reset(&obs0, &info0).map_err(EnvError::Backend)?;
     if trajectory.wants_field() {

@@ -22,6 +22,15 @@ use crate::flow::GeometrySpec;
 
 pub const REYNOLDS: [u32; 3] = [200, 1000, 3900];
 
+/// The square cylinder family over [`REYNOLDS`].
+pub struct Square;
+
+impl super::family::Family for Square {
+    fn specs(&self) -> Vec<super::family::Spec> {
+        super::registry::lbm(REYNOLDS.map(square))
+    }
+}
+
 /// Centre and side of the square.
 pub const CENTER: [f64; 2] = [10.0, 0.0];
 pub const SIDE: f64 = 1.0;

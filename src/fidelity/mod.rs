@@ -33,12 +33,8 @@ pub enum FidelityError {
     Validate(#[from] ValidateError),
     #[error("{path}: {message}")]
     Table { path: String, message: String },
-    #[error("cannot write {path}")]
-    Io {
-        path: String,
-        #[source]
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Record(#[from] crate::report::table::TableError),
 }
 
 impl FidelityError {
@@ -47,7 +43,7 @@ impl FidelityError {
         match self {
             FidelityError::NoReference { .. } | FidelityError::Table { .. } => true,
             FidelityError::Validate(v) => v.is_bad_input(),
-            FidelityError::Io { .. } => false,
+            FidelityError::Record(e) => matches!(e, crate::report::table::TableError::Malformed { .. }),
         }
     }
 }
@@ -162,30 +158,9 @@ pub fn has_reference(spec: &EnvSpec) -> bool {
 }
 
 /// Writes `rows` into the table at `path` (re-read first, so rows recorded meanwhile by other
-/// runs are kept), atomically: a temporary file renamed over the old one.
+/// runs are kept), atomically.
 pub fn record(path: &Path, rows: &[(String, Entry)]) -> Result<(), FidelityError> {
-    let shown = path.display().to_string();
-    let io = |source| FidelityError::Io {
-        path: shown.clone(),
-        source,
-    };
-    let text = match std::fs::read_to_string(path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
-        Err(e) => return Err(io(e)),
-    };
-    let mut entries = parse_table(&text, &shown)?;
-    for (k, e) in rows {
-        entries.insert(k.clone(), e.clone());
-    }
-    let header: String = text.lines().take_while(|l| l.starts_with('#')).map(|l| format!("{l}\n")).collect();
-    let body = toml::to_string_pretty(&entries).map_err(|e| FidelityError::Table {
-        path: shown.clone(),
-        message: e.to_string(),
-    })?;
-    let tmp = path.with_extension(format!("tmp.{}", std::process::id()));
-    std::fs::write(&tmp, format!("{header}\n{body}")).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(io)
+    crate::report::table::record(path, rows).map_err(FidelityError::from)
 }
 
 #[cfg(test)]
@@ -195,7 +170,7 @@ mod tests {
     #[test]
     fn committed_table_parses_and_names_registered_ids() {
         let entries = parse_table(TABLE, "fidelity.toml").unwrap();
-        let ids: Vec<String> = crate::env::registry::all().into_iter().map(|s| s.id).collect();
+        let ids: Vec<String> = crate::env::registry::all().iter().map(|s| s.id().to_string()).collect();
         for k in entries.keys() {
             let (id, level) = k.split_once('@').unwrap();
             assert!(ids.iter().any(|i| i == id), "{k}: unknown ID");
@@ -206,12 +181,12 @@ mod tests {
     /// The environment's case runs the environment's flow: same set-up, the case's references.
     #[test]
     fn env_case_runs_the_environment_flow() {
-        let spec = crate::env::spec("Cylinder_2D_Re100").unwrap();
+        let spec = crate::env::lbm_spec("Cylinder_2D_Re100").unwrap();
         let (c, case) = env_case(&spec, Level::Coarse).unwrap();
         assert_eq!(case, "cylinder_re100");
         assert_eq!(c.case.flow_setup(), spec.flow_setup());
         assert!(!c.case.reference.is_empty());
-        let err = env_case(&crate::env::spec("Cavity_2D_Re7500").unwrap(), Level::Coarse).unwrap_err();
+        let err = env_case(&crate::env::lbm_spec("Cavity_2D_Re7500").unwrap(), Level::Coarse).unwrap_err();
         assert!(err.is_bad_input(), "{err}");
     }
 }

@@ -6,3 +6,4 @@ pub mod eval;
 pub mod leaderboard;
 pub mod manifest;
 pub mod plots;
+pub mod table;

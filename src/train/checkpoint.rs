@@ -5,25 +5,26 @@
 use std::io::Write;
 use std::path::Path;
 
-use hgym_agents::learn::Algo;
 use serde::{Deserialize, Serialize};
 
 use super::curve::CurveRow;
 use crate::flow::Level;
 
-pub const FORMAT: u32 = 1;
+/// 2: the algorithm by name and its learner's own bytes (1 held an enum over the learners).
+pub const FORMAT: u32 = 2;
 pub const FILE: &str = "checkpoint.bin";
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Checkpoint {
     pub format: u32,
     pub env_id: String,
-    pub algo: Algo,
+    /// The algorithm's registered name.
+    pub algo: String,
     pub seed: u64,
     pub level: Level,
     /// The effective training configuration (TOML text).
     pub config_toml: String,
-    /// `Learner::to_bytes()`.
+    /// `Learner::to_bytes()` of that algorithm's learner.
     pub learner: Vec<u8>,
     pub curve: Vec<CurveRow>,
     /// Uncontrolled mean C_D of the periodic evaluation episodes.

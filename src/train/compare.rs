@@ -11,7 +11,6 @@
 
 use std::path::{Path, PathBuf};
 
-use hgym_agents::learn::Algo;
 use serde::{Deserialize, Serialize};
 
 use super::config::TrainConfig;
@@ -28,9 +27,10 @@ pub struct Protocol {
     pub env: String,
     pub level: Level,
     pub seeds: Vec<u64>,
-    pub algos: Vec<Algo>,
+    /// Registered algorithm names.
+    pub algos: Vec<String>,
     /// The algorithm whose final return sets the threshold.
-    pub reference: Algo,
+    pub reference: String,
     /// Fraction of the reference's improvement over the uncontrolled return.
     pub fraction: f64,
     /// Training configuration shared by every run (a `hgym train --config` file's content).
@@ -41,7 +41,15 @@ pub struct Protocol {
 impl Protocol {
     pub fn load(path: &Path) -> Result<Protocol, String> {
         let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-        toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
+        let mut p: Protocol = toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        for name in p.algos.iter().chain([&p.reference]) {
+            hgym_agents::learn::algorithm(name).map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+        if !p.algos.contains(&p.reference) {
+            return Err(format!("{}: the reference '{}' is not among algos", path.display(), p.reference));
+        }
+        p.config.algos = p.config.algos.complete().map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok(p)
     }
 }
 
@@ -114,14 +122,14 @@ fn final_eval(rows: &[CurveRow]) -> f64 {
 
 /// Reads the finished runs under `root/<algo>/seed<S>` and computes the comparison.
 pub fn analyse(p: &Protocol, root: &Path, r0: f64) -> Result<Comparison, String> {
-    let mut curves: Vec<(Algo, u64, PathBuf, Vec<CurveRow>, f64)> = vec![];
+    let mut curves: Vec<(String, u64, PathBuf, Vec<CurveRow>, f64)> = vec![];
     for algo in &p.algos {
         for seed in &p.seeds {
-            let dir = root.join(algo.name()).join(format!("seed{seed}"));
+            let dir = root.join(algo).join(format!("seed{seed}"));
             let text = std::fs::read_to_string(dir.join("curve.csv")).map_err(|e| format!("{}: {e}", dir.display()))?;
             let rows = from_csv(&text)?;
             let wall = rows.last().map(|r| r.wall_s).unwrap_or(f64::NAN);
-            curves.push((*algo, *seed, dir, rows, wall));
+            curves.push((algo.clone(), *seed, dir, rows, wall));
         }
     }
     let reference: Vec<f64> = curves.iter().filter(|c| c.0 == p.reference).map(|c| final_eval(&c.3)).collect();
@@ -130,7 +138,7 @@ pub fn analyse(p: &Protocol, root: &Path, r0: f64) -> Result<Comparison, String>
     let runs: Vec<RunResult> = curves
         .iter()
         .map(|(algo, seed, dir, rows, wall)| RunResult {
-            algo: algo.name().into(),
+            algo: algo.clone(),
             seed: *seed,
             dir: dir.clone(),
             final_return: final_eval(rows),
@@ -145,10 +153,10 @@ pub fn analyse(p: &Protocol, root: &Path, r0: f64) -> Result<Comparison, String>
         .algos
         .iter()
         .map(|a| {
-            let mine: Vec<&RunResult> = runs.iter().filter(|r| r.algo == a.name()).collect();
+            let mine: Vec<&RunResult> = runs.iter().filter(|r| r.algo == *a).collect();
             let reached: Vec<f64> = mine.iter().filter_map(|r| r.samples_to_threshold.map(|s| s as f64)).collect();
             AlgoSummary {
-                algo: a.name().into(),
+                algo: a.clone(),
                 final_return: Stat::of(&mine.iter().map(|r| r.final_return).collect::<Vec<_>>()),
                 samples_to_threshold: Stat::of(&reached),
                 seeds_reaching: reached.len(),
@@ -156,13 +164,10 @@ pub fn analyse(p: &Protocol, root: &Path, r0: f64) -> Result<Comparison, String>
             }
         })
         .collect();
-    let ref_samples = summary
-        .iter()
-        .find(|s| s.algo == p.reference.name())
-        .map(|s| s.samples_to_threshold.mean);
+    let ref_samples = summary.iter().find(|s| s.algo == p.reference).map(|s| s.samples_to_threshold.mean);
     let sample_reduction_vs_reference = summary
         .iter()
-        .filter(|s| s.algo != p.reference.name())
+        .filter(|s| s.algo != p.reference)
         .map(|s| (s.algo.clone(), 1.0 - s.samples_to_threshold.mean / ref_samples.unwrap_or(f64::NAN)))
         .collect();
     let cmp = Comparison {
@@ -181,7 +186,7 @@ pub fn analyse(p: &Protocol, root: &Path, r0: f64) -> Result<Comparison, String>
 
 /// Mean +- std over seeds of each algorithm's evaluation return against samples (evaluations
 /// happen at the same sample counts for every seed of an algorithm).
-fn plot(p: &Protocol, curves: &[(Algo, u64, PathBuf, Vec<CurveRow>, f64)], threshold: f64, r0: f64, path: &Path) -> Result<(), String> {
+fn plot(p: &Protocol, curves: &[(String, u64, PathBuf, Vec<CurveRow>, f64)], threshold: f64, r0: f64, path: &Path) -> Result<(), String> {
     let mut xs: Vec<Vec<f64>> = vec![];
     let mut ys: Vec<Vec<f64>> = vec![];
     let mut bands: Vec<Vec<f64>> = vec![];
@@ -205,7 +210,7 @@ fn plot(p: &Protocol, curves: &[(Algo, u64, PathBuf, Vec<CurveRow>, f64)], thres
         xs.push(x);
         ys.push(y);
         bands.push(b);
-        labels.push(format!("{} (mean +- std, {} seeds)", algo.name(), runs.len()));
+        labels.push(format!("{} (mean +- std, {} seeds)", algo, runs.len()));
     }
     let span = xs.iter().flat_map(|x| x.iter().copied()).fold(0.0, f64::max);
     let hx = [0.0, span];

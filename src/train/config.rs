@@ -1,13 +1,10 @@
 //! The training configuration: one TOML file with a `[train]` table (budget, evaluation,
-//! checkpoints), one table per algorithm (`[ppo]`, `[ddpg]`, `[td3]`, `[gppo]`) and an optional `[env]`
-//! table that overrides any field of the environment spec. Every field has a default;
+//! checkpoints), one table per registered algorithm (`[ppo]`, `[ddpg]`, `[td3]`, `[gppo]`: each
+//! algorithm reads its own, see `hgym_agents::learn`) and an optional `[env]` table that
+//! overrides any field of the environment spec. Every field has a default;
 //! `hgym train --print-config` prints the effective file.
 
-use hgym_agents::ddpg::DdpgConfig;
-use hgym_agents::gppo::GppoConfig;
 use hgym_agents::learn::AlgoConfigs;
-use hgym_agents::ppo::PpoConfig;
-use hgym_agents::td3::Td3Config;
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -45,32 +42,39 @@ impl Default for TrainSettings {
     }
 }
 
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+/// The file's tables. Every table but `[train]` and `[env]` is an algorithm's section
+/// (unknown ones are refused by [`TrainConfig::parse`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct TrainConfig {
     pub train: TrainSettings,
-    pub ppo: PpoConfig,
-    pub ddpg: DdpgConfig,
-    pub td3: Td3Config,
-    /// GPPO's own settings; its PPO hyperparameters are those of `[ppo]`.
-    pub gppo: GppoConfig,
+    #[serde(flatten)]
+    pub algos: AlgoConfigs,
     /// Overrides of the environment spec (any field of `hgym envs show ID`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub env: Option<toml::Table>,
 }
 
-impl TrainConfig {
-    pub fn parse(text: &str, origin: &str) -> Result<Self, String> {
-        toml::from_str(text).map_err(|e| format!("{origin}: {e}"))
-    }
-
-    pub fn algos(&self) -> AlgoConfigs {
-        AlgoConfigs {
-            ppo: self.ppo.clone(),
-            ddpg: self.ddpg.clone(),
-            td3: self.td3.clone(),
-            gppo: self.gppo.clone(),
+impl Default for TrainConfig {
+    /// Every section with its defaults.
+    fn default() -> Self {
+        TrainConfig {
+            train: TrainSettings::default(),
+            algos: AlgoConfigs::default()
+                .complete()
+                .expect("the algorithms' defaults are valid sections"),
+            env: None,
         }
+    }
+}
+
+impl TrainConfig {
+    /// Parses a configuration file's text, filling every algorithm's section with its defaults;
+    /// an unknown table or field is an error that names it (`origin` names the file).
+    pub fn parse(text: &str, origin: &str) -> Result<Self, String> {
+        let mut c: TrainConfig = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
+        c.algos = c.algos.complete().map_err(|e| format!("{origin}: {e}"))?;
+        Ok(c)
     }
 
     pub fn to_toml(&self) -> String {
@@ -88,33 +92,35 @@ mod tests {
         assert_eq!(TrainConfig::parse(&c.to_toml(), "x").unwrap(), c);
         let e = TrainConfig::parse("[td3]\nbatch = 3\n", "cfg.toml").unwrap_err();
         assert!(e.contains("batch"), "{e}");
+        let e = TrainConfig::parse("[tdd3]\nbatch_size = 3\n", "cfg.toml").unwrap_err();
+        assert!(e.contains("tdd3"), "{e}");
         let c = TrainConfig::parse("[td3]\nbatch_size = 64\n[train]\nsteps = 10\n", "x").unwrap();
-        assert_eq!((c.td3.batch_size, c.train.steps, c.ppo.n_epochs), (64, 10, 10));
+        let td3: hgym_agents::td3::Td3Config = c.algos.section("td3").unwrap();
+        let ppo: hgym_agents::ppo::PpoConfig = c.algos.section("ppo").unwrap();
+        assert_eq!((td3.batch_size, c.train.steps, ppo.n_epochs), (64, 10, 10));
     }
 
     #[test]
     fn env_overrides_merge_deeply() {
-        let spec = crate::env::any::lookup("Cylinder_2D_Re100").unwrap();
+        let spec = crate::env::lookup("Cylinder_2D_Re100").unwrap();
         let over: toml::Table = toml::from_str("control_interval = 0.5\n[actuation]\nmax_velocity = 0.5\n").unwrap();
-        let crate::env::any::AnySpec::Lbm(s) = spec.with_overrides(&over).unwrap() else {
-            panic!("family changed")
-        };
+        let merged = spec.with_overrides(&over).unwrap();
+        let s = merged.downcast::<crate::env::EnvSpec>().expect("family changed");
         assert_eq!(s.control_interval, 0.5);
-        match s.actuation {
+        match &s.actuation {
             crate::env::spec::ActuationSpec::ZnmfJets {
                 max_velocity, span_deg, ..
             } => {
-                assert_eq!((max_velocity, span_deg), (0.5, 10.0))
+                assert_eq!((*max_velocity, *span_deg), (0.5, 10.0))
             }
             _ => panic!("actuation kind changed"),
         }
         let bad: toml::Table = toml::from_str("control_intervall = 0.5\n").unwrap();
-        assert!(spec.with_overrides(&bad).unwrap_err().contains("control_intervall"));
-        let k = crate::env::any::lookup("Kolmogorov_2D_Re40").unwrap();
+        assert!(spec.with_overrides(&bad).unwrap_err().to_string().contains("control_intervall"));
+        let k = crate::env::lookup("Kolmogorov_2D_Re40").unwrap();
         let over: toml::Table = toml::from_str("[objective]\nkind = \"mixing\"\n").unwrap();
-        let crate::env::any::AnySpec::Kolmogorov(k) = k.with_overrides(&over).unwrap() else {
-            panic!("family changed")
-        };
+        let merged = k.with_overrides(&over).unwrap();
+        let k = merged.downcast::<crate::env::kolmogorov::KolmogorovSpec>().expect("family changed");
         assert_eq!(k.objective, crate::env::kolmogorov::Objective::Mixing);
     }
 }

@@ -20,7 +20,7 @@ pub mod eval;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use hgym_agents::learn::{Algo, Learner};
+use hgym_agents::learn::{algorithm, Learner};
 use hgym_agents::EnvError;
 use serde::{Deserialize, Serialize};
 
@@ -28,7 +28,7 @@ use self::checkpoint::Checkpoint;
 use self::config::TrainConfig;
 use self::curve::CurveRow;
 use self::eval::{evaluate, uncontrolled_c_d, EvalReport, Stat};
-use crate::env::any::{AnyEnv, AnySpec};
+use crate::env::{FlowEnv, Spec};
 use crate::flow::Level;
 use crate::report::manifest::{manifest, Manifest};
 
@@ -47,7 +47,8 @@ pub enum TrainError {
 #[derive(Clone, Debug)]
 pub struct TrainOptions {
     pub env_id: String,
-    pub algo: Algo,
+    /// A registered algorithm's name (`hgym_agents::learn::ALGORITHMS`).
+    pub algo: String,
     pub seed: u64,
     pub level: Level,
     pub config: TrainConfig,
@@ -76,12 +77,12 @@ pub enum Ending {
     },
 }
 
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct TrainManifest {
     pub schema: String,
     pub env_id: String,
     pub spec_hash: String,
-    pub spec: AnySpec,
+    pub spec: Spec,
     pub level: String,
     pub algo: String,
     pub seed: u64,
@@ -95,10 +96,10 @@ pub struct TrainManifest {
 }
 
 /// The environment spec with the configuration's `[env]` overrides applied.
-pub fn resolve_spec(env_id: &str, config: &TrainConfig) -> Result<AnySpec, TrainError> {
-    let spec = crate::env::any::lookup(env_id).map_err(|e| TrainError::Input(e.to_string()))?;
+pub fn resolve_spec(env_id: &str, config: &TrainConfig) -> Result<Spec, TrainError> {
+    let spec = crate::env::lookup(env_id).map_err(|e| TrainError::Input(e.to_string()))?;
     match &config.env {
-        Some(over) => spec.with_overrides(over).map_err(TrainError::Input),
+        Some(over) => spec.with_overrides(over).map_err(|e| TrainError::Input(e.to_string())),
         None => Ok(spec),
     }
 }
@@ -119,37 +120,38 @@ pub fn train(
     let config = &opts.config;
     let spec = resolve_spec(&opts.env_id, config)?;
     let (obs_dim, act_dim) = (spec.obs_dim(), spec.act_dim());
-    let algos = config.algos();
-    let n_envs = algos.n_envs(opts.algo);
+    let algo = algorithm(&opts.algo).map_err(|e| TrainError::Input(e.to_string()))?;
+    let input = |e: hgym_agents::learn::LearnError| TrainError::Input(e.to_string());
+    let n_envs = algo.n_envs(&config.algos).map_err(input)?;
     std::fs::create_dir_all(&opts.out).map_err(|e| TrainError::Io(format!("cannot create {}: {e}", opts.out.display())))?;
     let make = || spec.make(opts.level, opts.cache.clone());
-    let mut envs: Vec<AnyEnv> = (0..n_envs).map(|_| make()).collect::<Result<_, _>>()?;
+    let mut envs: Vec<Box<dyn FlowEnv>> = (0..n_envs).map(|_| make()).collect::<Result<_, _>>()?;
     let mut eval_env = make()?;
     let periodic_seeds = eval_seeds(config, config.train.eval_episodes.max(1));
 
     let (mut learner, mut curve, reference, wall_before, resumed) = match resume {
         Some(ck) => {
-            let learner = Learner::from_bytes(&ck.learner).map_err(|e| TrainError::Input(e.to_string()))?;
+            let learner = algo.decode(&ck.learner).map_err(input)?;
             (learner, ck.curve, ck.reference, ck.wall_s, ck.resumed + 1)
         }
         None => {
-            let learner = Learner::new(opts.algo, &algos, obs_dim, act_dim, opts.seed);
+            let learner = algo.learner(&config.algos, obs_dim, act_dim, opts.seed).map_err(input)?;
             let reference = uncontrolled_c_d(&mut eval_env, &periodic_seeds)?;
             (learner, vec![], reference, 0.0, 0)
         }
     };
     let config_toml = config.to_toml();
-    let checkpoint = |learner: &Learner, curve: &[CurveRow], wall_s: f64| {
+    let checkpoint = |learner: &dyn Learner, curve: &[CurveRow], wall_s: f64| {
         checkpoint::save(
             &opts.out,
             &Checkpoint {
                 format: checkpoint::FORMAT,
                 env_id: opts.env_id.clone(),
-                algo: opts.algo,
+                algo: opts.algo.clone(),
                 seed: opts.seed,
                 level: opts.level,
                 config_toml: config_toml.clone(),
-                learner: learner.to_bytes(),
+                learner: learner.to_bytes().map_err(|e| TrainError::Io(e.to_string()))?,
                 curve: curve.to_vec(),
                 reference: reference.clone(),
                 wall_s,
@@ -166,12 +168,12 @@ pub fn train(
         .map(|r| (r.eval_return, r.eval_drag_reduction_pct));
     while learner.samples() < config.train.steps {
         if interrupted() {
-            checkpoint(&learner, &curve, wall_before + started.elapsed().as_secs_f64())?;
+            checkpoint(&*learner, &curve, wall_before + started.elapsed().as_secs_f64())?;
             return Ok(Ending::Interrupted {
                 samples: learner.samples(),
             });
         }
-        let stats = learner.round(&mut envs)?;
+        let stats = learner.round_on(&mut envs)?;
         let n = stats.len().max(1) as f64;
         let mut row = CurveRow {
             round: learner.rounds(),
@@ -195,7 +197,7 @@ pub fn train(
             let r = evaluate(
                 &mut eval_env,
                 &mut policy,
-                opts.algo.name(),
+                algo.name(),
                 spec.id(),
                 &hash,
                 opts.level.name(),
@@ -219,12 +221,12 @@ pub fn train(
         });
         curve.push(row);
         if last_ckpt.elapsed().as_secs_f64() >= config.train.checkpoint_seconds {
-            checkpoint(&learner, &curve, wall_before + started.elapsed().as_secs_f64())?;
+            checkpoint(&*learner, &curve, wall_before + started.elapsed().as_secs_f64())?;
             last_ckpt = Instant::now();
         }
     }
     let wall = wall_before + started.elapsed().as_secs_f64();
-    checkpoint(&learner, &curve, wall)?;
+    checkpoint(&*learner, &curve, wall)?;
 
     // Final evaluation on its own seeds, against the uncontrolled flow from the same states.
     let final_seeds = eval_seeds(config, config.train.final_eval_episodes.max(1));
@@ -234,14 +236,15 @@ pub fn train(
     let mut trajectory = crate::data::trajectory::TrajectoryWriter::create(
         &opts.out.join("trajectory.mcap"),
         spec.control_interval(),
-        spec.trajectory_manifest(opts.level, opts.algo.name(), &final_seeds),
+        spec.trajectory_manifest(opts.level, algo.name(), &final_seeds)
+            .map_err(|e| TrainError::Io(format!("cannot describe the spec: {e}")))?,
     )
     .map_err(TrainError::Io)?
     .with_fields(config.train.fields_every);
     let report = evaluate(
         &mut eval_env,
         &mut policy,
-        opts.algo.name(),
+        algo.name(),
         spec.id(),
         &hash,
         opts.level.name(),
@@ -256,7 +259,7 @@ pub fn train(
     std::fs::write(opts.out.join("policy.json"), json(&policy) + "\n").map_err(io)?;
     std::fs::write(opts.out.join("metrics.json"), json(&report) + "\n").map_err(io)?;
     std::fs::write(opts.out.join("curve.csv"), curve::to_csv(&curve)).map_err(io)?;
-    let title = format!("{} {} seed {} ({})", spec.id(), opts.algo.name(), opts.seed, opts.level.name());
+    let title = format!("{} {} seed {} ({})", spec.id(), algo.name(), opts.seed, opts.level.name());
     curve::plot(&opts.out, &title, &curve).map_err(TrainError::Io)?;
     let m = TrainManifest {
         schema: "hgym/train/v1".into(),
@@ -264,7 +267,7 @@ pub fn train(
         spec_hash: hash,
         spec: spec.clone(),
         level: opts.level.name().into(),
-        algo: opts.algo.name().into(),
+        algo: algo.name().into(),
         seed: opts.seed,
         samples: learner.samples(),
         updates: learner.updates(),
@@ -287,7 +290,7 @@ pub fn resume_options(dir: &Path, steps: Option<u64>, cache: Option<PathBuf>) ->
     Ok((
         TrainOptions {
             env_id: ck.env_id.clone(),
-            algo: ck.algo,
+            algo: ck.algo.clone(),
             seed: ck.seed,
             level: ck.level,
             config,

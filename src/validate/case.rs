@@ -199,6 +199,20 @@ pub struct ReferenceSpec {
     #[serde(default)]
     pub abs_tolerance: Option<f64>,
     pub source: String,
+    /// `false` marks an unconfirmed reference: the report prints its deviation and `reason`,
+    /// but the case's pass or fail does not hang on it. Absent means judged.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub judged: Option<bool>,
+    /// Why a reference is not judged (required with `judged = false`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+}
+
+impl ReferenceSpec {
+    /// Whether the case's pass or fail hangs on this reference.
+    pub fn is_judged(&self) -> bool {
+        self.judged != Some(false)
+    }
 }
 
 impl Case {
@@ -353,6 +367,27 @@ impl LoadedCase {
                         ),
                     ))
                 }
+            }
+            let has_reason = r.reason.as_deref().is_some_and(|s| !s.trim().is_empty());
+            match (r.is_judged(), has_reason) {
+                (false, false) => {
+                    return Err(bad(
+                        name,
+                        "reference.reason",
+                        format!("'{}' has judged = false: say why in reason = \"...\"", r.quantity.name()),
+                    ))
+                }
+                (true, true) => {
+                    return Err(bad(
+                        name,
+                        "reference.reason",
+                        format!(
+                            "'{}': reason is only for judged = false; drop it or add judged = false",
+                            r.quantity.name()
+                        ),
+                    ))
+                }
+                _ => {}
             }
         }
         for q in &c.measure.quantities {

@@ -62,9 +62,15 @@ pub struct QuantityResult {
     pub tolerance_kind: Option<String>,
     /// Relative `(measured - reference) / |reference|` or absolute `measured - reference`.
     pub deviation: Option<f64>,
-    /// `None` for quantities measured without a reference.
+    /// Within tolerance; `None` for quantities measured without a reference.
     pub pass: Option<bool>,
     pub source: Option<String>,
+    /// `false` for an unconfirmed reference: `pass` is shown but the status ignores it.
+    #[serde(default = "judged_by_default", skip_serializing_if = "is_judged")]
+    pub judged: bool,
+    /// Why the reference is unconfirmed (with `judged = false`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
     /// The quantity over each batch of consecutive whole periods of the window (batch means,
     /// [`crate::validate::analysis::BATCHES`]); absent for short windows and in reports written
     /// before it was added.
@@ -76,7 +82,20 @@ pub struct QuantityResult {
     pub standard_error: Option<f64>,
 }
 
+fn judged_by_default() -> bool {
+    true
+}
+
+fn is_judged(judged: &bool) -> bool {
+    *judged
+}
+
 impl QuantityResult {
+    /// A quantity whose tolerance the case's status hangs on and which is outside it.
+    pub fn fails(&self) -> bool {
+        self.judged && self.pass == Some(false)
+    }
+
     /// The standard error as the table prints it: relative to the measured value (`±4.1%`) for
     /// relative tolerances and quantities without a reference, absolute (`±0.0040`) otherwise.
     pub fn standard_error_text(&self) -> Option<String> {
@@ -205,19 +224,17 @@ impl ValidationReport {
                 source,
                 standard_error: standard_error(&batches),
                 batches,
+                judged: r.is_none_or(|r| r.is_judged()),
+                reason: r.and_then(|r| r.reason.clone()),
             });
         }
         let (status, message) = match &out.status {
             RunStatus::Diverged { message, .. } => (Status::Diverged, Some(message.clone())),
             RunStatus::Completed => {
-                if quantities.iter().all(|q| q.pass != Some(false)) {
+                if !quantities.iter().any(QuantityResult::fails) {
                     (Status::Pass, None)
                 } else {
-                    let failed: Vec<String> = quantities
-                        .iter()
-                        .filter(|q| q.pass == Some(false))
-                        .map(|q| q.name.clone())
-                        .collect();
+                    let failed: Vec<String> = quantities.iter().filter(|q| q.fails()).map(|q| q.name.clone()).collect();
                     (Status::Fail, Some(format!("out of tolerance: {}", failed.join(", "))))
                 }
             }
@@ -358,10 +375,12 @@ impl ValidationReport {
                     q.tolerance.map_or("-".into(), |t| format!("{:.1}%", 100.0 * t)),
                 ),
             };
-            let res = match q.pass {
-                Some(true) => "pass",
-                Some(false) => "FAIL",
-                None => "(info)",
+            let res = match (q.pass, q.judged) {
+                (Some(true), true) => "pass",
+                (Some(false), true) => "FAIL",
+                (Some(true), false) => "within (unconfirmed ref.)",
+                (Some(false), false) => "outside (unconfirmed ref.)",
+                (None, _) => "(info)",
             };
             s += &format!(
                 "  {:<14} {:>10} {:>9} {:>10} {:>10} {:>10}  {}\n",
@@ -376,6 +395,10 @@ impl ValidationReport {
         }
         if let Some(m) = &self.message {
             s += &format!("  note: {m}\n");
+        }
+        for q in self.quantities.iter().filter(|q| !q.judged) {
+            let reason = q.reason.as_deref().unwrap_or("no reason recorded");
+            s += &format!("  note: {} is not judged (unconfirmed reference): {reason}\n", q.name);
         }
         if let Some(line) = self.broadband_note() {
             s += &format!("  note: {line}\n");
