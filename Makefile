@@ -12,13 +12,14 @@ LEVEL ?= default
 VENV ?= $(HOME)/.cache/hgym-venv
 PYTHON ?= python3
 
-.PHONY: all setup build test validate bench nightly lint fmt clean help leaderboard
+.PHONY: all setup build test validate bench nightly lint fmt clean help leaderboard peers
 
 help:
 	@echo "make validate   build, then validate the D2Q9 solver on the cylinder at Re 100 (LEVEL=$(LEVEL); the rest: make nightly)"
 	@echo "make test       unit, exact-solution, CLI and schema tests (coarse, fast)"
 	@echo "make bench      hgym bench lbm: MLUPS against the measured memory bandwidth"
 	@echo "make nightly    validations (default level), benchmarks, short trainings, leaderboard; results/nightly/summary.md"
+	@echo "make peers      install the peers hgym bench --peer runs beside ours (SB3, hydrogym[jax]; ~7 GB)"
 	@echo "make lint       rustfmt and clippy"
 	@echo "make leaderboard  aggregate results/ into results/LEADERBOARD.md"
 
@@ -32,6 +33,22 @@ $(VENV)/.installed: Makefile
 	@command -v $(PYTHON) >/dev/null || { echo "python3 not found (Python 3.11 is assumed)"; exit 2; }
 	$(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check "mcap>=1.2,<2" "pandas>=2" "pyarrow>=15" "datasets>=2.19" pyyaml
+	@touch $@
+
+# The peers `hgym bench agents --peer` and `hgym bench kolmogorov --peer` time beside ours, in a
+# venv of their own: hydrogym 1.0.0 pins huggingface-hub 0.16 and pandas 2.3, which break the
+# `datasets` the tests read exports with. PyPI's torch wheel brings its CUDA libraries (about
+# 6 GB); it runs on the CPU here. The gymnax 1.0.1 incompatibility of hydrogym 1.0.0 is adapted
+# in scripts/peers/hydrogym_kolmogorov.py, not patched into the installed files.
+PEERS_VENV ?= $(HOME)/.cache/hgym-peers
+
+peers: $(PEERS_VENV)/.installed
+
+$(PEERS_VENV)/.installed: Makefile
+	@command -v $(PYTHON) >/dev/null || { echo "python3 not found (Python 3.11 is assumed)"; exit 2; }
+	$(PYTHON) -m venv $(PEERS_VENV)
+	$(PEERS_VENV)/bin/pip install --quiet --disable-pip-version-check "stable-baselines3==2.9.2" "hydrogym[jax]==1.0.0" "gymnax==1.0.1"
+	$(PEERS_VENV)/bin/python -c "import stable_baselines3, torch, hydrogym.jax.envs.kolmogorov"
 	@touch $@
 
 build: setup

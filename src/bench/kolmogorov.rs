@@ -1,5 +1,8 @@
-//! `hgym bench kolmogorov`: the spectral solver's speed and accuracy. Ratios to HydroGym's JAX
-//! env need that peer measured in the same run, which is not built yet.
+//! `hgym bench kolmogorov`: the spectral solver's speed and accuracy, and with a peer
+//! (HydroGym's JAX env, [`super::peer`]) the same quantities of the peer measured in the same
+//! run, alternating with ours: steps per second at N 64 and dt 1e-3, and wall time per control
+//! action of 10 time units with each solver at its own step (ours the largest within tolerance,
+//! the peer's its default 1e-3), each step's accuracy stated against a quarter-step reference.
 //!
 //! Reports (1) Lawson-RK4 steps per second at N = 64, 128, 256 (dt = 1e-3, Re 40, from a developed
 //! state) and the cost of one step's VJP relative to a forward step; (2) accuracy against step
@@ -13,6 +16,8 @@ use std::time::Instant;
 
 use hgym_solvers::spectral::{Complex64 as C, Kolmogorov, KolmogorovConfig};
 use serde::{Deserialize, Serialize};
+
+use super::peer::{Pairs, Peer, PeerError};
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SizeRow {
@@ -35,7 +40,23 @@ pub struct KolmogorovBench {
     pub tolerance: f64,
     pub chosen_dt: f64,
     pub s_per_action: f64,
+    /// The peer measured in the same run (`--peer`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peer: Option<KolmogorovPeer>,
     pub pass: bool,
+}
+
+/// HydroGym's figures beside ours.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct KolmogorovPeer {
+    /// The peer's own description (versions, dt, precision, threads).
+    pub about: serde_json::Value,
+    /// Steps/s at dt 1e-3, and seconds per control action each at its own step.
+    pub pairs: Vec<Pairs>,
+    /// The peer's step and its relative L2 error after one action against a quarter of it.
+    pub dt: f64,
+    pub reference_dt: f64,
+    pub relative_error: f64,
 }
 
 fn solver(n: usize, dt: f64) -> Kolmogorov {
@@ -82,7 +103,7 @@ fn run_to(n: usize, dt: f64, w0: &[C], t: f64) -> (Vec<C>, f64) {
     (s.omega.clone(), start.elapsed().as_secs_f64())
 }
 
-pub fn bench_kolmogorov(quick: bool) -> KolmogorovBench {
+pub fn bench_kolmogorov(quick: bool, peer: Option<&mut Peer>) -> Result<KolmogorovBench, PeerError> {
     let mut sizes = vec![];
     let ns: &[usize] = if quick { &[64] } else { &[64, 128, 256] };
     for &n in ns {
@@ -149,20 +170,58 @@ pub fn bench_kolmogorov(quick: bool) -> KolmogorovBench {
             relative_error: f64::NAN,
             s_per_action: f64::NAN,
         });
-    // Ratios to HydroGym's JAX env need that peer measured in the same run (not built yet): only
-    // the peer-free target is judged here.
-    KolmogorovBench {
+    let peer = match peer {
+        None => None,
+        Some(p) => Some(with_peer(p, quick, &w0, chosen.dt)?),
+    };
+    Ok(KolmogorovBench {
         pass: sizes.iter().all(|s| s.vjp_over_step <= 3.0),
         sizes,
         accuracy,
         tolerance,
         chosen_dt: chosen.dt,
         s_per_action: chosen.s_per_action,
+        peer,
+    })
+}
+
+/// Alternating pairs of one control action (10 time units, N 64) by us and by the peer: our
+/// steps/s at dt 1e-3 against its steps/s at its dt (1e-3), and our seconds per action at
+/// `our_dt` against its at its dt; then the peer's accuracy at its dt.
+fn with_peer(p: &mut Peer, quick: bool, w0: &[C], our_dt: f64) -> Result<KolmogorovPeer, PeerError> {
+    let (mut rates, mut actions) = (vec![], vec![]);
+    for _ in 0..if quick { 1 } else { 3 } {
+        let (_, at_1e3) = run_to(64, 1e-3, w0, 10.0);
+        let (_, at_ours) = run_to(64, our_dt, w0, 10.0);
+        let v = p.ask("action")?;
+        let number = |key: &str| {
+            v.get(key).and_then(|x| x.as_f64()).ok_or_else(|| PeerError::Failed {
+                script: "hydrogym_kolmogorov.py".into(),
+                message: format!("answer to 'action' has no number '{key}': {v}"),
+            })
+        };
+        rates.push((10.0 / 1e-3 / at_1e3, number("steps_per_s")?));
+        actions.push((at_ours, number("s_per_action")?));
     }
+    let acc = p.ask("accuracy")?;
+    let get = |key: &str| acc.get(key).and_then(|x| x.as_f64()).unwrap_or(f64::NAN);
+    Ok(KolmogorovPeer {
+        about: p.about.clone(),
+        pairs: vec![
+            Pairs::new("steps/s, N 64, dt 1e-3", "steps/s", &rates, true),
+            Pairs::new("s per action, own dt", "s", &actions, false),
+        ],
+        dt: get("dt"),
+        reference_dt: get("reference_dt"),
+        relative_error: get("relative_error"),
+    })
 }
 
 pub fn table(b: &KolmogorovBench) -> String {
-    let mut s = String::from("Kolmogorov flow, Re 40, Lawson RK4 (no peer measured in this run, so no ratio to HydroGym's JAX env)\n");
+    let mut s = String::from(match b.peer {
+        None => "Kolmogorov flow, Re 40, Lawson RK4 (no peer measured in this run, so no ratio to HydroGym's JAX env; --peer runs it)\n",
+        Some(_) => "Kolmogorov flow, Re 40, Lawson RK4 (the peer's pairs below)\n",
+    });
     s += "     N   steps/s (dt 1e-3)   VJP / step\n";
     for r in &b.sizes {
         s += &format!("{:6} {:16.0} {:12.2}\n", r.n, r.steps_per_s, r.vjp_over_step);
@@ -178,5 +237,16 @@ pub fn table(b: &KolmogorovBench) -> String {
         b.s_per_action,
         if b.pass { "PASS" } else { "SHORT of target" }
     );
+    if let Some(p) = &b.peer {
+        let ours_err = b.accuracy.iter().find(|a| a.dt == b.chosen_dt).map_or(f64::NAN, |a| a.relative_error);
+        s += &format!("against {} (same run, alternating pairs):\n", super::peer::describe(&p.about));
+        for pair in &p.pairs {
+            s += &format!("  {}\n", pair.line("HydroGym"));
+        }
+        s += &format!(
+            "  steps per action: hgym dt {} (error {:.1e} against dt 2.5e-4), HydroGym dt {} (error {:.1e} against dt {})\n",
+            b.chosen_dt, ours_err, p.dt, p.relative_error, p.reference_dt
+        );
+    }
     s
 }

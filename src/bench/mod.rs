@@ -17,6 +17,7 @@ pub mod agents;
 pub mod envs;
 pub mod kolmogorov;
 mod lbm;
+pub mod peer;
 mod refine;
 mod stream;
 

@@ -1,10 +1,11 @@
 //! `hgym bench`: speed against the machine's limits (LBM kernel, refinement, environments,
 //! learners, the spectral solver).
 
+use hgym::bench::peer::{Peer, PeerError};
 use anyhow::{Context, Result};
 use clap::Subcommand;
 
-use crate::{Outcome, UsageError};
+use crate::{thread_pool, Outcome, UsageError};
 use hgym::bench::{bench_lbm, bench_refine, LbmBenchOptions, RefineBenchOptions};
 use hgym::flow::Level;
 
@@ -36,8 +37,9 @@ pub enum BenchCommand {
         quick: bool,
     },
     /// Learner speed: TD3 updates/s (256x256, batch 256), PPO epochs/s (64x64), batch-1 policy
-    /// latency. No ratio to SB3 (the peer is not run here yet). Exit 1 if a policy evaluation
-    /// takes 10 us or more.
+    /// latency. With --peer, Stable-Baselines3's TD3 at the same shapes is timed in the same run,
+    /// alternating with ours, and the ratios printed; without it, no ratio. Exit 1 if a policy
+    /// evaluation takes 10 us or more; 2 if --peer is given and the peers are not installed.
     Agents {
         #[arg(long)]
         json: bool,
@@ -46,16 +48,25 @@ pub enum BenchCommand {
         quick: bool,
         #[arg(long)]
         threads: Option<usize>,
+        /// Time Stable-Baselines3 beside ours (`make peers` installs it).
+        #[arg(long)]
+        peer: bool,
     },
-    /// Spectral Kolmogorov solver: steps/s at N 64-256, VJP cost, accuracy against step size. No
-    /// ratio to HydroGym's JAX env (the peer is not run here yet). Exit 1 if a VJP costs more
-    /// than 3 steps.
+    /// Spectral Kolmogorov solver: steps/s at N 64-256, VJP cost, accuracy against step size.
+    /// With --peer, HydroGym's JAX Kolmogorov env (N 64, Re 40, float64) is timed in the same run,
+    /// alternating with ours, with each one's step size and accuracy per control action. Exit 1 if
+    /// a VJP costs more than 3 steps; 2 if --peer is given and the peers are not installed.
     Kolmogorov {
         #[arg(long)]
         json: bool,
         /// Short timings and a 1-time-unit action (targets not judged).
         #[arg(long)]
         quick: bool,
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Time HydroGym's JAX env beside ours (`make peers` installs it).
+        #[arg(long)]
+        peer: bool,
     },
     /// Control steps (actions) per second of each environment family at coarse and default.
     Envs {
@@ -95,9 +106,21 @@ pub fn run(cmd: BenchCommand) -> Result<Outcome> {
             quick,
             family,
         } => run_bench_envs(json, actions, quick, &family),
-        BenchCommand::Agents { json, quick, threads } => super::train::run_bench_agents(json, quick, threads),
-        BenchCommand::Kolmogorov { json, quick } => {
-            let b = hgym::bench::kolmogorov::bench_kolmogorov(quick);
+        BenchCommand::Agents {
+            json,
+            quick,
+            threads,
+            peer,
+        } => run_bench_agents(json, quick, threads, peer),
+        BenchCommand::Kolmogorov {
+            json,
+            quick,
+            threads,
+            peer,
+        } => {
+            let (pool, n) = thread_pool(threads)?;
+            let mut peer = start_peer(peer, hgym::bench::peer::HYDROGYM_KOLMOGOROV, n)?;
+            let b = pool.install(|| hgym::bench::kolmogorov::bench_kolmogorov(quick, peer.as_mut()))?;
             print_report(json, &b, &hgym::bench::kolmogorov::table(&b))?;
             Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
         }
@@ -183,4 +206,29 @@ fn run_bench_envs(json: bool, actions: usize, quick: bool, families: &[String]) 
         print!("{}", hgym::bench::envs::table(&rows));
     }
     Ok(Outcome::Ok)
+}
+
+/// The peer, if asked for; missing peers are bad input (exit 2) with the install command.
+fn start_peer(wanted: bool, script: (&str, &str), threads: usize) -> Result<Option<Peer>> {
+    if !wanted {
+        return Ok(None);
+    }
+    eprintln!("starting the peer {} with {threads} thread(s) ...", script.0);
+    match Peer::start(script, threads) {
+        Ok(p) => Ok(Some(p)),
+        Err(e @ PeerError::Missing { .. }) => Err(UsageError(e.to_string()).into()),
+        Err(e) => Err(e.into()),
+    }
+}
+
+fn run_bench_agents(json: bool, quick: bool, threads: Option<usize>, peer: bool) -> Result<Outcome> {
+    let (pool, n) = thread_pool(threads)?;
+    let mut peer = start_peer(peer, hgym::bench::peer::SB3_TD3, n)?;
+    let b = pool.install(|| hgym::bench::agents::bench_agents(quick, peer.as_mut()))?;
+    if json {
+        println!("{}", serde_json::to_string_pretty(&b)?);
+    } else {
+        print!("{}", hgym::bench::agents::table(&b));
+    }
+    Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
 }

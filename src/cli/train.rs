@@ -463,17 +463,6 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
     })
 }
 
-pub fn run_bench_agents(json: bool, quick: bool, threads: Option<usize>) -> Result<Outcome> {
-    let (pool, _) = thread_pool(threads)?;
-    let b = pool.install(|| hgym::bench::agents::bench_agents(quick));
-    if json {
-        println!("{}", serde_json::to_string_pretty(&b)?);
-    } else {
-        print!("{}", hgym::bench::agents::table(&b));
-    }
-    Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
-}
-
 #[derive(Args)]
 pub struct CompareArgs {
     /// A protocol file, e.g. benchmarks/protocols/kolmogorov_gppo.toml.

@@ -323,7 +323,7 @@ impl LoadedCase {
     }
 
     /// Checks that do not depend on the resolution level.
-    fn check_static(&self) -> Result<(), ValidateError> {
+    pub(crate) fn check_static(&self) -> Result<(), ValidateError> {
         let c = &self.case;
         let name = c.case.name.as_str();
         if name.is_empty() || !name.chars().all(|ch| ch.is_ascii_alphanumeric() || ch == '_' || ch == '-') {
