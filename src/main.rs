@@ -132,6 +132,14 @@ fn main() -> ExitCode {
                     || c.downcast_ref::<hgym::fidelity::FidelityError>().is_some_and(|v| v.is_bad_input())
                     || c.downcast_ref::<UsageError>().is_some()
                     || c.downcast_ref::<hgym::env::EnvInputError>().is_some()
+                    || matches!(
+                        c.downcast_ref::<hgym_agents::EnvError>(),
+                        Some(hgym_agents::EnvError::InvalidSpec(_))
+                    )
+                    || matches!(
+                        c.downcast_ref::<hgym::train::TrainError>(),
+                        Some(hgym::train::TrainError::Input(_) | hgym::train::TrainError::Env(hgym_agents::EnvError::InvalidSpec(_)))
+                    )
             });
             ExitCode::from(if bad_input { 2 } else { 1 })
         }

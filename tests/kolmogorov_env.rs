@@ -39,7 +39,7 @@ fn every_kolmogorov_id_honours_the_contract_at_coarse() {
             assert!(!r.terminated, "{id}: {:?}", r.info.text("reason"));
             assert_eq!(r.truncated, k == 5, "{id}: truncated exactly at the last action");
             assert!(space.contains(&r.obs), "{id}: observation outside [-5, 5]");
-            let again = env.reward_from_info(&r.info);
+            let again = env.reward_from_info(&r.info).unwrap();
             assert!(
                 (again - r.reward).abs() <= 1e-12 * (1.0 + r.reward.abs()),
                 "{id}: reward {} vs from info {again}",

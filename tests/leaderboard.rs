@@ -59,3 +59,29 @@ fn leaderboard_rebuilds_the_committed_one_from_the_committed_results() {
     }
     assert!(pngs >= 1);
 }
+
+/// A folder whose metrics.json is damaged is listed as a problem row (JSON, markdown, a warning
+/// on stderr), not silently left out; the readable runs are still ranked.
+#[test]
+fn malformed_result_folders_become_problem_rows() {
+    let root = &common::repo();
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    copy_results(&root.join("results/eval"), &results.join("eval"));
+    let broken = results.join("eval/Cylinder_2D_Re100-zero-coarse");
+    std::fs::write(broken.join("metrics.json"), "{\"schema\": \"hgym/eval/v1\", \"env_id\": ").unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_hgym"))
+        .args(["leaderboard", "--json", "--results", results.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let lb: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let problems = lb["problems"].as_array().expect("a problems list");
+    assert_eq!(problems.len(), 1, "{lb:#}");
+    assert!(problems[0]["dir"].as_str().unwrap().ends_with("Cylinder_2D_Re100-zero-coarse"));
+    assert!(problems[0]["message"].as_str().unwrap().contains("not JSON"));
+    assert!(!lb["entries"].as_array().unwrap().is_empty());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("could not be read"));
+    let md = std::fs::read_to_string(results.join("LEADERBOARD.md")).unwrap();
+    assert!(md.contains("Folders that could not be read") && md.contains("Cylinder_2D_Re100-zero-coarse"));
+}

@@ -209,6 +209,20 @@ fn bad_training_input_is_named() {
     let o = hgym(&["train", "--env", "Cylinder_2D_Re100", "--config", p.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o).contains("batchsize"), "{}", text(&o));
+    // An override that parses but cannot run is bad input too (exit 2), named.
+    std::fs::write(&p, "[env]\nreynolds = -5.0\n[train]\nsteps = 10\n").unwrap();
+    let out = tmp.path().join("runs");
+    let o = hgym(&[
+        "train",
+        "--env",
+        "Cylinder_2D_Re100",
+        "--config",
+        p.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("reynolds"), "{}", text(&o));
     let o = hgym(&["train", "--env", "Cylinder_2D_Re100", "--seeds", "3..1"]);
     assert_eq!(o.status.code(), Some(2));
     let o = hgym(&["eval", "--policy", "bogus", "--env", "Cylinder_2D_Re100"]);

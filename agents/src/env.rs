@@ -53,6 +53,10 @@ pub enum EnvError {
     NonFiniteAction { index: usize, value: f64 },
     #[error("step called before reset (or after the episode ended): call reset first")]
     NeedsReset,
+    /// The environment's spec (or its overrides) describes something that cannot run: the
+    /// user's input, not a failure of the run.
+    #[error("{0}")]
+    InvalidSpec(String),
     #[error("{0}")]
     Backend(String),
 }

@@ -238,7 +238,11 @@ pub fn table(b: &KolmogorovBench) -> String {
         if b.pass { "PASS" } else { "SHORT of target" }
     );
     if let Some(p) = &b.peer {
-        let ours_err = b.accuracy.iter().find(|a| a.dt == b.chosen_dt).map_or(f64::NAN, |a| a.relative_error);
+        let ours_err = b
+            .accuracy
+            .iter()
+            .find(|a| a.dt == b.chosen_dt)
+            .map_or(f64::NAN, |a| a.relative_error);
         s += &format!("against {} (same run, alternating pairs):\n", super::peer::describe(&p.about));
         for pair in &p.pairs {
             s += &format!("  {}\n", pair.line("HydroGym"));

@@ -19,10 +19,7 @@ use thiserror::Error;
 /// Stable-Baselines3's TD3 at hgym's shapes.
 pub const SB3_TD3: (&str, &str) = ("sb3_td3.py", include_str!("../../scripts/peers/sb3_td3.py"));
 /// HydroGym's JAX Kolmogorov environment.
-pub const HYDROGYM_KOLMOGOROV: (&str, &str) = (
-    "hydrogym_kolmogorov.py",
-    include_str!("../../scripts/peers/hydrogym_kolmogorov.py"),
-);
+pub const HYDROGYM_KOLMOGOROV: (&str, &str) = ("hydrogym_kolmogorov.py", include_str!("../../scripts/peers/hydrogym_kolmogorov.py"));
 
 #[derive(Debug, Error)]
 pub enum PeerError {
@@ -240,7 +237,9 @@ mod tests {
 
     #[test]
     fn a_missing_interpreter_says_how_to_install_it() {
-        let e = Peer::start_with(Path::new("/nonexistent/python"), SB3_TD3, 1).err().expect("must fail");
+        let e = Peer::start_with(Path::new("/nonexistent/python"), SB3_TD3, 1)
+            .err()
+            .expect("must fail");
         assert!(matches!(e, PeerError::Missing { .. }));
         assert!(e.to_string().contains("make peers"), "{e}");
     }

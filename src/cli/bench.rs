@@ -1,9 +1,9 @@
 //! `hgym bench`: speed against the machine's limits (LBM kernel, refinement, environments,
 //! learners, the spectral solver).
 
-use hgym::bench::peer::{Peer, PeerError};
 use anyhow::{Context, Result};
 use clap::Subcommand;
+use hgym::bench::peer::{Peer, PeerError};
 
 use crate::{thread_pool, Outcome, UsageError};
 use hgym::bench::{bench_lbm, bench_refine, LbmBenchOptions, RefineBenchOptions};

@@ -41,6 +41,15 @@ pub struct LeaderboardArgs {
 pub fn leaderboard(args: LeaderboardArgs) -> Result<Outcome> {
     let lb = hgym::report::leaderboard::build(&args.results, args.env.as_deref());
     hgym::report::leaderboard::write(&args.results, &lb).map_err(anyhow::Error::msg)?;
+    if !lb.problems.is_empty() {
+        eprintln!(
+            "warning: {} result folder(s) could not be read (listed in LEADERBOARD.md):",
+            lb.problems.len()
+        );
+        for p in &lb.problems {
+            eprintln!("  {}: {}", p.dir.display(), p.message);
+        }
+    }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&lb)?);
     } else {

@@ -51,13 +51,15 @@ pub fn run(args: RunArgs) -> Result<Outcome> {
     let spec = match hgym::train::resolve_spec(&args.env, &config) {
         Ok(s) => match s.downcast::<hgym::env::EnvSpec>() {
             Some(s) => s.clone(),
-            None => return Err(UsageError(format!(
+            None => {
+                return Err(UsageError(format!(
                 "`hgym run` draws lattice-Boltzmann flows; {} runs on the {} solver: use `hgym eval --policy zero|random|sine --env {}`",
                 s.id(),
                 s.solver(),
                 s.id()
             ))
-            .into()),
+                .into())
+            }
         },
         Err(hgym::train::TrainError::Input(m)) => return Err(UsageError(m).into()),
         Err(e) => return Err(e.into()),

@@ -119,14 +119,15 @@ pub fn calibrate(
     let mut forces = [0.0f64; 2];
     for k in 0..actions {
         let r = env.step(&zero)?;
-        forces[0] += r.info.get("C_D").unwrap_or(0.0);
-        forces[1] += r.info.get("C_L").unwrap_or(0.0);
         if r.terminated {
             return Err(EnvError::Backend(format!(
                 "{}: uncontrolled run diverged: {}",
                 spec.id,
                 r.info.text("reason").unwrap_or("?")
             )));
+        }
+        for (sum, key) in forces.iter_mut().zip(["C_D", "C_L"]) {
+            *sum += super::info_value(&r.info, key)?;
         }
         let raw = env.raw_observation()?;
         for i in 0..dim {

@@ -31,7 +31,7 @@ use sha2::{Digest, Sha256};
 
 use super::family::{merged, CalibrateError, Family, FamilySpec, FlowEnv, Spec};
 use super::seeding::splitmix64;
-use super::EnvInputError;
+use super::{info_value, EnvInputError};
 use crate::flow::{Level, ResolutionSpec};
 
 pub const REYNOLDS: [u32; 3] = [40, 100, 200];
@@ -433,16 +433,17 @@ impl KolmogorovEnv {
         }
     }
 
-    /// Recomputes the reward from a step's info (the contract's consistency check).
-    pub fn reward_from_info(&self, info: &Info) -> f64 {
+    /// Recomputes the reward from a step's info (the contract's consistency check); an error
+    /// names a missing key.
+    pub fn reward_from_info(&self, info: &Info) -> Result<f64, EnvError> {
         let flow = match self.spec.objective {
             Objective::Dissipation { extreme_weight } => {
-                -(info.get("dissipation").unwrap_or(f64::NAN) + extreme_weight * info.get("dissipation_excess").unwrap_or(f64::NAN))
+                -(info_value(info, "dissipation")? + extreme_weight * info_value(info, "dissipation_excess")?)
                     / self.spec.dissipation_laminar()
             }
-            Objective::Mixing => info.get("tke").unwrap_or(f64::NAN) / self.tke_ref,
+            Objective::Mixing => info_value(info, "tke")? / self.tke_ref,
         };
-        flow - self.spec.action_penalty * info.get("action_sq").unwrap_or(f64::NAN)
+        Ok(flow - self.spec.action_penalty * info_value(info, "action_sq")?)
     }
 }
 
@@ -595,8 +596,8 @@ pub fn calibrate(spec: &KolmogorovSpec, level: Level, actions: usize, progress: 
         }
         u2 += r.obs.iter().map(|v| v * v).sum::<f64>();
         count += r.obs.len();
-        eps.push(r.info.get("dissipation").unwrap_or(f64::NAN));
-        tke += r.info.get("tke").unwrap_or(f64::NAN);
+        eps.push(info_value(&r.info, "dissipation")?);
+        tke += info_value(&r.info, "tke")?;
         progress(k + 1);
     }
     let n = eps.len() as f64;

@@ -76,7 +76,10 @@ impl LbmEnv {
             spec.normalization = n;
         }
         let setup = spec.flow_setup();
-        let flow_error = |e: FlowError| EnvError::Backend(format!("{}: {e}", spec.id));
+        let flow_error = |e: FlowError| match e {
+            FlowError::Invalid { .. } => EnvError::InvalidSpec(format!("{}: {e}", spec.id)),
+            FlowError::Solver(_) => EnvError::Backend(format!("{}: {e}", spec.id)),
+        };
         setup.check().map_err(flow_error)?;
         let plan = setup.plan(level).map_err(flow_error)?;
         let units = plan.units;
@@ -116,7 +119,7 @@ impl LbmEnv {
         let steps_per_action = units.steps(spec.control_interval).max(1);
         let circle = |i: usize| match spec.bodies.get(i) {
             Some(GeometrySpec::Circle { center, diameter }) => Ok((*center, 0.5 * diameter)),
-            _ => Err(EnvError::Backend(format!("{}: actuated body {i} must be a circle", spec.id))),
+            _ => Err(EnvError::InvalidSpec(format!("{}: actuated body {i} must be a circle", spec.id))),
         };
         let (jets, centers) = match &spec.actuation {
             ActuationSpec::ZnmfJets {
@@ -143,13 +146,16 @@ impl LbmEnv {
             }
             ActuationSpec::Jets { body, jets, .. } => {
                 if *body >= spec.bodies.len() {
-                    return Err(EnvError::Backend(format!("{}: jets on body {body}, which does not exist", spec.id)));
+                    return Err(EnvError::InvalidSpec(format!(
+                        "{}: jets on body {body}, which does not exist",
+                        spec.id
+                    )));
                 }
                 (jets.clone(), vec![])
             }
             ActuationSpec::Rotation { bodies, .. } => (vec![], bodies.iter().map(|&i| circle(i).map(|c| c.0)).collect::<Result<_, _>>()?),
             ActuationSpec::InletTemperature { .. } if thermal.is_none() => {
-                return Err(EnvError::Backend(format!(
+                return Err(EnvError::InvalidSpec(format!(
                     "{}: an inlet-temperature actuator needs a [thermal] section",
                     spec.id
                 )));

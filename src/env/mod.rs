@@ -50,3 +50,9 @@ pub fn default_cache_dir() -> Option<std::path::PathBuf> {
     }
     std::env::var_os("HOME").map(|h| std::path::PathBuf::from(h).join(".cache/hgym/states"))
 }
+
+/// `info[key]`, or an error naming the key the step did not write (no silent default).
+pub fn info_value(info: &hgym_agents::Info, key: &str) -> Result<f64, hgym_agents::EnvError> {
+    info.get(key)
+        .ok_or_else(|| hgym_agents::EnvError::Backend(format!("the step's info has no '{key}'")))
+}

@@ -126,12 +126,20 @@ pub fn rollout(
         trajectory
             .step_with_field(&a, &r, Some(|| env.snapshot()))
             .map_err(EnvError::Backend)?;
-        m.t.push(r.info.get("t").unwrap_or(0.0));
+        m.t.push(super::info_value(&r.info, "t")?);
         m.reward.push(r.reward);
-        m.c_d.push(r.info.get("C_D").unwrap_or(f64::NAN));
-        m.c_l.push(r.info.get("C_L").unwrap_or(f64::NAN));
+        // A diverged step has no forces: NaN marks it in the series.
+        let force = |key: &str| {
+            if r.terminated {
+                Ok(r.info.get(key).unwrap_or(f64::NAN))
+            } else {
+                super::info_value(&r.info, key)
+            }
+        };
+        m.c_d.push(force("C_D")?);
+        m.c_l.push(force("C_L")?);
         for (j, col) in m.actuation.iter_mut().enumerate() {
-            col.push(r.info.get(&format!("actuation_{j}")).unwrap_or(0.0));
+            col.push(super::info_value(&r.info, &format!("actuation_{j}"))?);
         }
         progress(k + 1, opts.actions);
         if r.terminated {

@@ -90,8 +90,8 @@ pub fn validate(level: Level, out: &Path, progress: &mut dyn FnMut(usize, usize)
                 r.info.text("reason").unwrap_or("?")
             )));
         }
-        t.push(r.info.get("t").unwrap_or(f64::NAN));
-        d.push(r.info.get("dissipation").unwrap_or(f64::NAN) / d_lam);
+        t.push(crate::env::info_value(&r.info, "t")?);
+        d.push(crate::env::info_value(&r.info, "dissipation")? / d_lam);
         progress(k + 1, s.episode_actions);
     }
     let m = d.len() as f64;

@@ -39,6 +39,17 @@ pub struct Entry {
 pub struct Leaderboard {
     pub schema: String,
     pub entries: Vec<Entry>,
+    /// Result folders that hold a `metrics.json` that could not be read as an evaluation: listed,
+    /// not silently left out.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub problems: Vec<Problem>,
+}
+
+/// A result folder left out of the ranking, and why.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Problem {
+    pub dir: PathBuf,
+    pub message: String,
 }
 
 struct Run {
@@ -53,12 +64,32 @@ struct Run {
     dir: PathBuf,
 }
 
-fn read_json(p: &Path) -> Option<serde_json::Value> {
-    serde_json::from_str(&std::fs::read_to_string(p).ok()?).ok()
+fn read_json(p: &Path) -> Result<serde_json::Value, String> {
+    let text = std::fs::read_to_string(p).map_err(|e| format!("cannot read {}: {e}", p.display()))?;
+    serde_json::from_str(&text).map_err(|e| format!("{} is not JSON: {e}", p.display()))
 }
 
-/// Every folder below `dir` holding a `metrics.json` of the evaluation schema.
-fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>) {
+/// The evaluation in folder `p`'s `metrics.json`: `Ok(None)` for `hgym run`'s time series (no
+/// schema, a `t` column), which are not evaluations; an error for anything else unreadable.
+fn read_eval(p: &Path) -> Result<Option<(EvalReport, serde_json::Value)>, String> {
+    let v = read_json(&p.join("metrics.json"))?;
+    if v.get("schema").is_none() && v.get("t").is_some() {
+        return Ok(None);
+    }
+    if v["schema"] != "hgym/eval/v1" {
+        return Err(format!("metrics.json has schema {}, not hgym/eval/v1", v["schema"]));
+    }
+    let report = serde_json::from_value::<EvalReport>(v).map_err(|e| format!("metrics.json: {e}"))?;
+    let manifest = match p.join("manifest.json") {
+        m if m.exists() => read_json(&m)?,
+        _ => serde_json::Value::Null,
+    };
+    Ok(Some((report, manifest)))
+}
+
+/// Every folder below `dir` holding a `metrics.json` of the evaluation schema; folders whose
+/// `metrics.json` cannot be read go to `problems`.
+fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Problem>) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     let mut entries: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
     entries.sort();
@@ -66,42 +97,53 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>) {
         if !p.is_dir() {
             continue;
         }
-        let metrics = p.join("metrics.json");
-        if let Some(v) = read_json(&metrics).filter(|v| v["schema"] == "hgym/eval/v1") {
-            let Ok(report) = serde_json::from_value::<EvalReport>(v) else {
+        let shown = p.strip_prefix(root).unwrap_or(&p).to_path_buf();
+        if !p.join("metrics.json").exists() {
+            collect(&p, root, out, problems);
+            continue;
+        }
+        let (report, manifest) = match read_eval(&p) {
+            Ok(Some(r)) => r,
+            Ok(None) => continue,
+            Err(message) => {
+                problems.push(Problem { dir: shown, message });
+                continue;
+            }
+        };
+        let trained = manifest["schema"] == "hgym/train/v1";
+        let policy = if trained {
+            let Some(algo) = manifest["algo"].as_str() else {
+                problems.push(Problem {
+                    dir: shown,
+                    message: "manifest.json of a training run names no algo".into(),
+                });
                 continue;
             };
-            let manifest = read_json(&p.join("manifest.json")).unwrap_or_default();
-            let trained = manifest["schema"] == "hgym/train/v1";
-            let policy = if trained {
-                manifest["algo"].as_str().unwrap_or("?").to_string()
-            } else {
-                manifest["policy"].as_str().unwrap_or(&report.policy).to_string()
-            };
-            out.push(Run {
-                env_id: report.env_id.clone(),
-                level: report.level.clone(),
-                policy,
-                kind: if trained { "learned" } else { "baseline" },
-                samples: manifest["samples"].as_u64(),
-                wall: manifest["manifest"]["wall_time_s"].as_f64(),
-                version: manifest["manifest"]["git_commit"]
-                    .as_str()
-                    .map(|c| format!("{} ({c})", manifest["manifest"]["code_version"].as_str().unwrap_or("hgym")))
-                    .or_else(|| manifest["manifest"]["code_version"].as_str().map(|s| s.to_string())),
-                dir: p.strip_prefix(root).unwrap_or(&p).to_path_buf(),
-                report,
-            });
+            algo.to_string()
         } else {
-            collect(&p, root, out);
-        }
+            manifest["policy"].as_str().unwrap_or(&report.policy).to_string()
+        };
+        out.push(Run {
+            env_id: report.env_id.clone(),
+            level: report.level.clone(),
+            policy,
+            kind: if trained { "learned" } else { "baseline" },
+            samples: manifest["samples"].as_u64(),
+            wall: manifest["manifest"]["wall_time_s"].as_f64(),
+            version: manifest["manifest"]["git_commit"]
+                .as_str()
+                .map(|c| format!("{} ({c})", manifest["manifest"]["code_version"].as_str().unwrap_or("hgym")))
+                .or_else(|| manifest["manifest"]["code_version"].as_str().map(|s| s.to_string())),
+            dir: shown,
+            report,
+        });
     }
 }
 
 /// Builds the leaderboard from everything under `results` (optionally one environment).
 pub fn build(results: &Path, env: Option<&str>) -> Leaderboard {
-    let mut runs = vec![];
-    collect(results, results.parent().unwrap_or(Path::new(".")), &mut runs);
+    let (mut runs, mut problems) = (vec![], vec![]);
+    collect(results, results.parent().unwrap_or(Path::new(".")), &mut runs, &mut problems);
     let mut groups: BTreeMap<(String, String, String, String), Vec<Run>> = BTreeMap::new();
     for r in runs.into_iter().filter(|r| env.is_none_or(|e| r.env_id == e)) {
         let key = (r.env_id.clone(), r.level.clone(), r.report.spec_hash.clone(), r.policy.clone());
@@ -148,6 +190,7 @@ pub fn build(results: &Path, env: Option<&str>) -> Leaderboard {
     Leaderboard {
         schema: "hgym/leaderboard/v1".into(),
         entries,
+        problems,
     }
 }
 
@@ -191,6 +234,12 @@ pub fn markdown(lb: &Leaderboard) -> String {
             e.wall_time_s.map(|v| format!("{v:.0} s")).unwrap_or_else(|| "–".into()),
             e.code_versions.join(", ")
         );
+    }
+    if !lb.problems.is_empty() {
+        s += "\n## Folders that could not be read\n\n| folder | problem |\n|---|---|\n";
+        for p in &lb.problems {
+            s += &format!("| {} | {} |\n", p.dir.display(), p.message.replace('|', "\\|"));
+        }
     }
     s
 }

@@ -608,7 +608,12 @@ mod tests {
         c.case.reference.retain(|x| x.quantity != crate::validate::case::Quantity::ClRms);
         let out = synthetic_output(&shedding);
         assert_eq!(ValidationReport::from_run(&c, &out, 1).status, Status::Pass);
-        let cd = c.case.reference.iter_mut().find(|x| x.quantity == crate::validate::case::Quantity::MeanCd).unwrap();
+        let cd = c
+            .case
+            .reference
+            .iter_mut()
+            .find(|x| x.quantity == crate::validate::case::Quantity::MeanCd)
+            .unwrap();
         cd.value = 2.0; // the synthetic run's mean C_D is 1.46: 27 % off
         cd.judged = Some(false);
         cd.reason = Some("no independent value".into());
@@ -616,15 +621,28 @@ mod tests {
         let r = ValidationReport::from_run(&c, &out, 1);
         assert_eq!(r.status, Status::Pass, "{}", r.table());
         let table = r.table();
-        assert!(table.contains("outside (unconfirmed ref.)") && table.contains("no independent value"), "{table}");
+        assert!(
+            table.contains("outside (unconfirmed ref.)") && table.contains("no independent value"),
+            "{table}"
+        );
         let judged = |c: &mut LoadedCase| {
-            let cd = c.case.reference.iter_mut().find(|x| x.quantity == crate::validate::case::Quantity::MeanCd).unwrap();
+            let cd = c
+                .case
+                .reference
+                .iter_mut()
+                .find(|x| x.quantity == crate::validate::case::Quantity::MeanCd)
+                .unwrap();
             cd.judged = None;
             cd.reason = None;
         };
         judged(&mut c);
         assert_eq!(ValidationReport::from_run(&c, &out, 1).status, Status::Fail);
-        let cd = c.case.reference.iter_mut().find(|x| x.quantity == crate::validate::case::Quantity::MeanCd).unwrap();
+        let cd = c
+            .case
+            .reference
+            .iter_mut()
+            .find(|x| x.quantity == crate::validate::case::Quantity::MeanCd)
+            .unwrap();
         cd.judged = Some(false);
         let e = c.check_static().unwrap_err();
         assert!(e.to_string().contains("reason"), "{e}");
