@@ -132,6 +132,7 @@ fn main() -> ExitCode {
                     || c.downcast_ref::<hgym::fidelity::FidelityError>().is_some_and(|v| v.is_bad_input())
                     || c.downcast_ref::<UsageError>().is_some()
                     || c.downcast_ref::<hgym::env::EnvInputError>().is_some()
+                    || matches!(c.downcast_ref::<hgym::data::DataError>(), Some(hgym::data::DataError::Format(_)))
                     || matches!(
                         c.downcast_ref::<hgym_agents::EnvError>(),
                         Some(hgym_agents::EnvError::InvalidSpec(_))

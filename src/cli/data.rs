@@ -151,7 +151,10 @@ pub enum DataCommand {
 pub fn run_data(cmd: DataCommand) -> Result<Outcome> {
     let DataCommand::Recover { file, out, json } = cmd;
     let out = out.unwrap_or_else(|| file.with_extension("recovered.mcap"));
-    let r = hgym::data::trajectory::recover(&file, &out).map_err(UsageError)?;
+    if !file.is_file() {
+        return Err(UsageError(format!("{} is not a file (give a trajectory.mcap to salvage)", file.display())).into());
+    }
+    let r = hgym::data::trajectory::recover(&file, &out)?;
     if json {
         println!("{}", serde_json::to_string_pretty(&r)?);
     } else {

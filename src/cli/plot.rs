@@ -40,7 +40,7 @@ pub struct LeaderboardArgs {
 /// `hgym leaderboard`: writes results/leaderboard.json, LEADERBOARD.md and the bar charts.
 pub fn leaderboard(args: LeaderboardArgs) -> Result<Outcome> {
     let lb = hgym::report::leaderboard::build(&args.results, args.env.as_deref());
-    hgym::report::leaderboard::write(&args.results, &lb).map_err(anyhow::Error::msg)?;
+    hgym::report::leaderboard::write(&args.results, &lb)?;
     if !lb.problems.is_empty() {
         eprintln!(
             "warning: {} result folder(s) could not be read (listed in LEADERBOARD.md):",

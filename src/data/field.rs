@@ -5,6 +5,7 @@
 //! zstd-compressed like every other channel. hgym adds `episode`, `step`, `t` and `extent`
 //! (x0, x1, y0, y1 in the env's units) to the Grid's fields.
 
+use super::DataError;
 use base64::Engine;
 use serde_json::{json, Value};
 
@@ -40,10 +41,10 @@ pub struct Snapshot {
 
 impl Snapshot {
     /// The `foxglove.Grid` JSON message.
-    pub fn encode(&self) -> Result<Vec<u8>, String> {
+    pub fn encode(&self) -> Result<Vec<u8>, DataError> {
         let cells = self.nx * self.ny;
         if let Some((name, f)) = self.fields.iter().find(|(_, f)| f.len() != cells) {
-            return Err(format!("field {name} has {} values, the grid {cells}", f.len()));
+            return Err(DataError::Format(format!("field {name} has {} values, the grid {cells}", f.len())));
         }
         let k = self.fields.len();
         let mut data = Vec::with_capacity(cells * k * 4);
@@ -70,56 +71,52 @@ impl Snapshot {
             "t": self.t,
             "extent": self.extent,
         });
-        serde_json::to_vec(&v).map_err(|e| e.to_string())
+        Ok(serde_json::to_vec(&v)?)
     }
 
     /// The inverse of [`Snapshot::encode`].
-    pub fn decode(bytes: &[u8]) -> Result<Snapshot, String> {
-        let v: Value = serde_json::from_slice(bytes).map_err(|e| format!("field message: {e}"))?;
-        let int = |k: &str| v[k].as_u64().ok_or_else(|| format!("field message without {k}"));
+    pub fn decode(bytes: &[u8]) -> Result<Snapshot, DataError> {
+        let bad = |what: String| DataError::Format(format!("field message: {what}"));
+        let v: Value = serde_json::from_slice(bytes).map_err(|e| bad(e.to_string()))?;
+        let int = |k: &str| v[k].as_u64().ok_or_else(|| bad(format!("no integer {k}")));
         let nx = int("column_count")? as usize;
         let stride = int("cell_stride")? as usize;
+        let text = v["data"].as_str().ok_or_else(|| bad("no data".into()))?;
         let data = base64::engine::general_purpose::STANDARD
-            .decode(v["data"].as_str().unwrap_or(""))
-            .map_err(|e| format!("field data: {e}"))?;
+            .decode(text)
+            .map_err(|e| bad(format!("data: {e}")))?;
         if nx == 0 || stride == 0 || data.len() % (nx * stride) != 0 {
-            return Err("field message: data does not fill whole rows".into());
+            return Err(bad("data does not fill whole rows".into()));
         }
         let ny = data.len() / (nx * stride);
-        let names: Vec<(String, usize)> = v["fields"]
+        let listed = v["fields"].as_array().ok_or_else(|| bad("no fields list".into()))?;
+        let mut fields = vec![];
+        for f in listed {
+            let name = f["name"].as_str().ok_or_else(|| bad("a field without a name".into()))?;
+            let off = f["offset"].as_u64().ok_or_else(|| bad(format!("field {name} without an offset")))? as usize;
+            if off + 4 > stride {
+                return Err(bad(format!("field {name} at offset {off} does not fit a {stride}-byte cell")));
+            }
+            let vals = (0..nx * ny)
+                .map(|c| {
+                    let b = &data[c * stride + off..c * stride + off + 4];
+                    f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+                })
+                .collect();
+            fields.push((name.to_string(), vals));
+        }
+        let extent = v["extent"]
             .as_array()
-            .map(|a| {
-                a.iter()
-                    .map(|f| {
-                        (
-                            f["name"].as_str().unwrap_or("").to_string(),
-                            f["offset"].as_u64().unwrap_or(0) as usize,
-                        )
-                    })
-                    .collect()
-            })
-            .unwrap_or_default();
-        let fields = names
-            .into_iter()
-            .map(|(name, off)| {
-                let vals = (0..nx * ny)
-                    .map(|c| {
-                        let b = &data[c * stride + off..c * stride + off + 4];
-                        f32::from_le_bytes([b[0], b[1], b[2], b[3]])
-                    })
-                    .collect();
-                (name, vals)
-            })
-            .collect();
-        let e = v["extent"].as_array().cloned().unwrap_or_default();
-        let ext = |k: usize| e.get(k).and_then(|x| x.as_f64()).unwrap_or(f64::NAN);
+            .filter(|e| e.len() == 4)
+            .and_then(|e| e.iter().map(|x| x.as_f64()).collect::<Option<Vec<f64>>>())
+            .ok_or_else(|| bad("extent is not four numbers".into()))?;
         Ok(Snapshot {
             episode: int("episode")?,
             step: int("step")?,
-            t: v["t"].as_f64().unwrap_or(f64::NAN),
+            t: v["t"].as_f64().ok_or_else(|| bad("no time t".into()))?,
             nx,
             ny,
-            extent: [ext(0), ext(1), ext(2), ext(3)],
+            extent: [extent[0], extent[1], extent[2], extent[3]],
             fields,
         })
     }

@@ -19,9 +19,7 @@ use mcap::records::{MessageHeader, Metadata};
 use mcap::write::Writer;
 use serde_json::json;
 
-fn err(e: impl std::fmt::Display) -> String {
-    format!("MCAP: {e}")
-}
+use super::DataError;
 
 const OBS_SCHEMA: &str = r#"{"type":"object","properties":{"episode":{"type":"integer"},"step":{"type":"integer"},"obs":{"type":"array","items":{"type":"number"}}},"required":["episode","step","obs"]}"#;
 const ACTION_SCHEMA: &str = r#"{"type":"object","properties":{"episode":{"type":"integer"},"step":{"type":"integer"},"normalised":{"type":"array","items":{"type":"number"}},"physical":{"type":"array","items":{"type":"number"}}},"required":["episode","step","normalised","physical"]}"#;
@@ -42,14 +40,13 @@ pub struct TrajectoryWriter {
 
 impl TrajectoryWriter {
     /// Creates `path` with the manifest (string key-values) as metadata.
-    pub fn create(path: &Path, control_interval: f64, manifest: BTreeMap<String, String>) -> Result<Self, String> {
-        let file = File::create(path).map_err(|e| format!("cannot create {}: {e}", path.display()))?;
+    pub fn create(path: &Path, control_interval: f64, manifest: BTreeMap<String, String>) -> Result<Self, DataError> {
+        let file = File::create(path).map_err(DataError::io(path))?;
         let mut w = mcap::WriteOptions::new()
             .compression(Some(mcap::Compression::Zstd))
             .profile("hgym")
             .library(format!("hgym {}", env!("CARGO_PKG_VERSION")))
-            .create(BufWriter::new(file))
-            .map_err(err)?;
+            .create(BufWriter::new(file))?;
         let mut channels = [0u16; 5];
         for (k, (topic, schema)) in [
             ("/obs", OBS_SCHEMA),
@@ -65,14 +62,13 @@ impl TrajectoryWriter {
                 "/field" => "foxglove.Grid".to_string(),
                 _ => format!("hgym{}", topic.replace('/', ".")),
             };
-            let sid = w.add_schema(&name, "jsonschema", schema.as_bytes()).map_err(err)?;
-            channels[k] = w.add_channel(sid, topic, "json", &BTreeMap::new()).map_err(err)?;
+            let sid = w.add_schema(&name, "jsonschema", schema.as_bytes())?;
+            channels[k] = w.add_channel(sid, topic, "json", &BTreeMap::new())?;
         }
         w.write_metadata(&Metadata {
             name: "manifest".into(),
             metadata: manifest,
-        })
-        .map_err(err)?;
+        })?;
         Ok(TrajectoryWriter {
             writer: Some(w),
             channels,
@@ -98,21 +94,21 @@ impl TrajectoryWriter {
     }
 
     /// Writes a flow-field snapshot of the current step.
-    pub fn field(&mut self, mut s: super::field::Snapshot) -> Result<(), String> {
+    pub fn field(&mut self, mut s: super::field::Snapshot) -> Result<(), DataError> {
         (s.episode, s.step, s.t) = (self.episode, self.step, self.t);
         let data = s.encode()?;
         self.put_bytes(4, &data)
     }
 
-    fn put(&mut self, channel: usize, value: serde_json::Value) -> Result<(), String> {
-        let data = serde_json::to_vec(&value).map_err(err)?;
+    fn put(&mut self, channel: usize, value: serde_json::Value) -> Result<(), DataError> {
+        let data = serde_json::to_vec(&value)?;
         self.put_bytes(channel, &data)
     }
 
-    fn put_bytes(&mut self, channel: usize, data: &[u8]) -> Result<(), String> {
+    fn put_bytes(&mut self, channel: usize, data: &[u8]) -> Result<(), DataError> {
         let log_time = (self.global_step as f64 * self.interval_ns) as u64;
         self.sequence += 1;
-        let w = self.writer.as_mut().ok_or("MCAP: writer already finished")?;
+        let w = self.writer.as_mut().ok_or(DataError::Finished)?;
         w.write_to_known_channel(
             &MessageHeader {
                 channel_id: self.channels[channel],
@@ -121,8 +117,8 @@ impl TrajectoryWriter {
                 publish_time: log_time,
             },
             data,
-        )
-        .map_err(err)
+        )?;
+        Ok(())
     }
 
     fn info_json(&self, info: &Info) -> serde_json::Value {
@@ -130,7 +126,7 @@ impl TrajectoryWriter {
     }
 
     /// Step 0 of a new episode: the reset's observation and info.
-    pub fn reset(&mut self, obs: &[f64], info: &Info) -> Result<(), String> {
+    pub fn reset(&mut self, obs: &[f64], info: &Info) -> Result<(), DataError> {
         self.step = 0;
         self.t = info.get("t").unwrap_or(0.0);
         self.put(0, json!({"episode": self.episode, "step": 0, "obs": obs}))?;
@@ -140,7 +136,7 @@ impl TrajectoryWriter {
 
     /// One step: the action taken (normalised; physical values from info `actuation_k`) and
     /// what it returned. Closes the chunk at the episode's end.
-    pub fn step(&mut self, action: &[f64], r: &StepResult) -> Result<(), String> {
+    pub fn step(&mut self, action: &[f64], r: &StepResult) -> Result<(), DataError> {
         self.step_with_field(action, r, None::<fn() -> super::field::Snapshot>)
     }
 
@@ -151,7 +147,7 @@ impl TrajectoryWriter {
         action: &[f64],
         r: &StepResult,
         snapshot: Option<F>,
-    ) -> Result<(), String> {
+    ) -> Result<(), DataError> {
         self.step += 1;
         self.global_step += 1;
         self.t = r.info.get("t").unwrap_or(f64::NAN);
@@ -180,16 +176,17 @@ impl TrajectoryWriter {
     }
 
     /// Closes the current chunk (everything so far survives a kill) and starts a new episode.
-    pub fn end_episode(&mut self) -> Result<(), String> {
+    pub fn end_episode(&mut self) -> Result<(), DataError> {
         self.episode += 1;
         self.global_step += 1;
-        self.writer.as_mut().ok_or("MCAP: writer already finished")?.flush().map_err(err)
+        self.writer.as_mut().ok_or(DataError::Finished)?.flush()?;
+        Ok(())
     }
 
     /// Writes the summary and index; the file is complete.
-    pub fn finish(&mut self) -> Result<(), String> {
+    pub fn finish(&mut self) -> Result<(), DataError> {
         if let Some(mut w) = self.writer.take() {
-            w.finish().map_err(err)?;
+            w.finish()?;
         }
         Ok(())
     }
@@ -213,16 +210,19 @@ pub struct Recovery {
 
 /// Copies every message of every complete chunk (and the metadata) of a possibly truncated file
 /// `input` into a new, valid file `output`.
-pub fn recover(input: &Path, output: &Path) -> Result<Recovery, String> {
+pub fn recover(input: &Path, output: &Path) -> Result<Recovery, DataError> {
     use mcap::read::{LinearReader, MessageStream, Options};
-    let buf = std::fs::read(input).map_err(|e| format!("cannot read {}: {e}", input.display()))?;
+    let buf = std::fs::read(input).map_err(DataError::io(input))?;
     if !buf.starts_with(mcap::MAGIC) {
-        return Err(format!("{} is not an MCAP file (no magic bytes at the start)", input.display()));
+        return Err(DataError::Format(format!(
+            "{} is not an MCAP file (no magic bytes at the start)",
+            input.display()
+        )));
     }
     let opts = enumset::EnumSet::only(Options::IgnoreEndMagic);
     let mut metadata = vec![];
     let mut stopped_at = None;
-    for rec in LinearReader::new_with_options(&buf, opts).map_err(err)? {
+    for rec in LinearReader::new_with_options(&buf, opts)? {
         match rec {
             Ok(mcap::records::Record::Metadata(m)) => metadata.push(m),
             Ok(_) => {}
@@ -233,7 +233,7 @@ pub fn recover(input: &Path, output: &Path) -> Result<Recovery, String> {
         }
     }
     let mut messages = vec![];
-    for m in MessageStream::new_with_options(&buf, opts).map_err(err)? {
+    for m in MessageStream::new_with_options(&buf, opts)? {
         match m {
             Ok(m) => messages.push(m),
             Err(e) => {
@@ -242,19 +242,18 @@ pub fn recover(input: &Path, output: &Path) -> Result<Recovery, String> {
             }
         }
     }
-    let file = File::create(output).map_err(|e| format!("cannot create {}: {e}", output.display()))?;
+    let file = File::create(output).map_err(DataError::io(output))?;
     let mut w = mcap::WriteOptions::new()
         .compression(Some(mcap::Compression::Zstd))
         .profile("hgym")
-        .create(BufWriter::new(file))
-        .map_err(err)?;
+        .create(BufWriter::new(file))?;
     for m in &metadata {
-        w.write_metadata(m).map_err(err)?;
+        w.write_metadata(m)?;
     }
     for m in &messages {
-        w.write(m).map_err(err)?;
+        w.write(m)?;
     }
-    w.finish().map_err(err)?;
+    w.finish()?;
     Ok(Recovery {
         messages: messages.len(),
         metadata: metadata.len(),

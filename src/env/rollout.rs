@@ -9,11 +9,12 @@ use serde::{Deserialize, Serialize};
 
 use super::spec::EnvSpec;
 use super::LbmEnv;
+use crate::data::DataError;
 use crate::env::fields::FlowFields;
 use crate::flow::vorticity_field;
 use crate::flow::Level;
 use crate::report::manifest::{manifest, Manifest};
-use crate::report::plots;
+use crate::report::{plots, ReportError};
 
 /// Open-loop policies for smoke runs and baselines.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
@@ -88,7 +89,7 @@ pub fn rollout(
     opts: &RolloutOptions,
     progress: &mut dyn FnMut(usize, usize),
     stop: &dyn Fn() -> bool,
-) -> Result<RolloutManifest, EnvError> {
+) -> Result<RolloutManifest, RolloutError> {
     let started = Instant::now();
     let mut spec_run = spec.clone();
     spec_run.episode_actions = opts.actions.max(1);
@@ -100,11 +101,11 @@ pub fn rollout(
         .trajectory_manifest(opts.level, &policy_name, &[opts.seed])
         .map_err(|e| EnvError::Backend(format!("cannot describe the spec: {e}")))?;
     let trajectory = crate::data::trajectory::TrajectoryWriter::create(&opts.out.join("trajectory.mcap"), spec.control_interval, metadata)
-        .map_err(EnvError::Backend)?;
+        .map_err(RolloutError::from)?;
     let mut trajectory = trajectory.with_fields(opts.fields_every);
-    trajectory.reset(&obs0, &info0).map_err(EnvError::Backend)?;
+    trajectory.reset(&obs0, &info0).map_err(RolloutError::from)?;
     if trajectory.wants_field() {
-        trajectory.field(env.snapshot()).map_err(EnvError::Backend)?;
+        trajectory.field(env.snapshot()).map_err(RolloutError::from)?;
     }
     let dim = spec.act_dim();
     let mut rng = Rng(opts.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
@@ -125,7 +126,7 @@ pub fn rollout(
         let r = env.step(&a)?;
         trajectory
             .step_with_field(&a, &r, Some(|| env.snapshot()))
-            .map_err(EnvError::Backend)?;
+            .map_err(RolloutError::from)?;
         m.t.push(super::info_value(&r.info, "t")?);
         m.reward.push(r.reward);
         // A diverged step has no forces: NaN marks it in the series.
@@ -156,7 +157,7 @@ pub fn rollout(
             break;
         }
     }
-    trajectory.finish().map_err(EnvError::Backend)?;
+    trajectory.finish().map_err(RolloutError::from)?;
     let n = m.reward.len();
     let summary = RolloutManifest {
         schema: "hgym/rollout/v1".into(),
@@ -175,17 +176,35 @@ pub fn rollout(
         mean_c_d: m.c_d.iter().filter(|v| v.is_finite()).sum::<f64>() / n.max(1) as f64,
         manifest: manifest(rayon::current_num_threads(), started.elapsed().as_secs_f64()),
     };
-    write(&opts.out, &summary, &m, &env).map_err(EnvError::Backend)?;
+    write(&opts.out, &summary, &m, &env)?;
     Ok(summary)
 }
 
-fn write(dir: &Path, summary: &RolloutManifest, m: &Metrics, env: &LbmEnv) -> Result<(), String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    let put = |name: &str, text: String| {
-        std::fs::write(dir.join(name), text + "\n").map_err(|e| format!("cannot write {}: {e}", dir.join(name).display()))
+/// Why a rollout stopped short of its files.
+#[derive(Debug, thiserror::Error)]
+pub enum RolloutError {
+    #[error(transparent)]
+    Env(#[from] EnvError),
+    #[error("writing the trajectory")]
+    Trajectory(#[from] DataError),
+    #[error(transparent)]
+    Report(#[from] ReportError),
+}
+
+fn write(dir: &Path, summary: &RolloutManifest, m: &Metrics, env: &LbmEnv) -> Result<(), ReportError> {
+    std::fs::create_dir_all(dir).map_err(ReportError::io(dir))?;
+    let json = |what: &str, text: serde_json::Result<String>| {
+        text.map_err(|source| ReportError::Json {
+            what: what.to_string(),
+            source,
+        })
     };
-    put("manifest.json", serde_json::to_string_pretty(summary).map_err(|e| e.to_string())?)?;
-    put("metrics.json", serde_json::to_string_pretty(m).map_err(|e| e.to_string())?)?;
+    let put = |name: &str, text: String| {
+        let path = dir.join(name);
+        std::fs::write(&path, text + "\n").map_err(ReportError::io(&path))
+    };
+    put("manifest.json", json("the manifest", serde_json::to_string_pretty(summary))?)?;
+    put("metrics.json", json("the metrics", serde_json::to_string_pretty(m))?)?;
     let mut panels = vec![
         plots::Series {
             label: "reward",

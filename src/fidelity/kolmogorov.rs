@@ -176,7 +176,7 @@ pub fn validate(level: Level, out: &Path, progress: &mut dyn FnMut(usize, usize)
             },
         ],
     )
-    .map_err(EnvError::Backend)?;
+    .map_err(|e| EnvError::Backend(crate::report::chain(&e)))?;
     Ok(report)
 }
 

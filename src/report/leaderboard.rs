@@ -245,16 +245,18 @@ pub fn markdown(lb: &Leaderboard) -> String {
 }
 
 /// Writes `leaderboard.json`, `LEADERBOARD.md` and `leaderboard/<ID>-<level>.png` under `results`.
-pub fn write(results: &Path, lb: &Leaderboard) -> Result<(), String> {
-    let io = |e: std::io::Error| format!("writing the leaderboard under {}: {e}", results.display());
-    std::fs::write(
-        results.join("leaderboard.json"),
-        serde_json::to_string_pretty(lb).map_err(|e| e.to_string())? + "\n",
-    )
-    .map_err(io)?;
-    std::fs::write(results.join("LEADERBOARD.md"), markdown(lb)).map_err(io)?;
+pub fn write(results: &Path, lb: &Leaderboard) -> Result<(), super::ReportError> {
+    use super::ReportError;
+    let json = serde_json::to_string_pretty(lb).map_err(|source| ReportError::Json {
+        what: "the leaderboard".into(),
+        source,
+    })?;
+    let path = results.join("leaderboard.json");
+    std::fs::write(&path, json + "\n").map_err(ReportError::io(&path))?;
+    let path = results.join("LEADERBOARD.md");
+    std::fs::write(&path, markdown(lb)).map_err(ReportError::io(&path))?;
     let dir = results.join("leaderboard");
-    std::fs::create_dir_all(&dir).map_err(io)?;
+    std::fs::create_dir_all(&dir).map_err(ReportError::io(&dir))?;
     let mut by_env: BTreeMap<(String, String, String), Vec<&Entry>> = BTreeMap::new();
     for e in &lb.entries {
         let short = e.spec_hash[..e.spec_hash.len().min(8)].to_string();

@@ -20,8 +20,20 @@ fn fonts() {
     });
 }
 
-fn err<E: std::fmt::Debug>(path: &Path) -> impl Fn(E) -> String + '_ {
-    move |e| format!("could not draw {}: {e:?}", path.display())
+/// A plot that could not be drawn or written, with the plotting library's error.
+#[derive(Debug, thiserror::Error)]
+#[error("could not draw {}", path.display())]
+pub struct PlotError {
+    pub path: std::path::PathBuf,
+    #[source]
+    pub source: Box<dyn std::error::Error + Send + Sync>,
+}
+
+fn err<E: std::error::Error + Send + Sync + 'static>(path: &Path) -> impl Fn(E) -> PlotError + '_ {
+    move |e| PlotError {
+        path: path.to_path_buf(),
+        source: Box::new(e),
+    }
 }
 
 /// Plot range of a series: from the 0.2 % to the 99.8 % quantile of its finite values after the
@@ -46,7 +58,7 @@ pub struct Series<'a> {
 }
 
 /// Stacked time series against `t`, with the window `[w0, w1]` shaded.
-pub fn time_series(path: &Path, title: &str, t: &[f64], panels: &[Series], window: Option<[f64; 2]>) -> Result<(), String> {
+pub fn time_series(path: &Path, title: &str, t: &[f64], panels: &[Series], window: Option<[f64; 2]>) -> Result<(), PlotError> {
     fonts();
     let root = BitMapBackend::new(path, (1200, 360 * panels.len() as u32)).into_drawing_area();
     root.fill(&WHITE).map_err(err(path))?;
@@ -116,7 +128,7 @@ pub fn spectrum(
     amps: &[f64],
     f_max: f64,
     marks: &[(f64, String, RGBColor)],
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     fonts();
     let root = BitMapBackend::new(path, (1000, 500)).into_drawing_area();
     root.fill(&WHITE).map_err(err(path))?;
@@ -182,7 +194,7 @@ fn diverging(v: f64) -> RGBColor {
 
 /// Writes `f` as a PNG colour map titled `label`, with a symmetric colour range at the 98th
 /// percentile of |value| (so a few extremes do not wash out the rest).
-pub fn field_png(f: &crate::flow::Field, path: &Path, label: &str) -> Result<(), String> {
+pub fn field_png(f: &crate::flow::Field, path: &Path, label: &str) -> Result<(), PlotError> {
     let vmax = abs_quantile(&f.values, 0.98);
     let title = format!("{label} (colour range +-{vmax:.2})");
     field(path, &title, f.nx, f.ny, f.extent, &f.values, vmax)
@@ -190,7 +202,7 @@ pub fn field_png(f: &crate::flow::Field, path: &Path, label: &str) -> Result<(),
 
 /// Colour map of a field on `[x0, x1] x [y0, y1]` (row-major, `NaN` drawn grey), symmetric
 /// colour range `+-vmax`.
-pub fn field(path: &Path, title: &str, nx: usize, ny: usize, extent: [f64; 4], values: &[f32], vmax: f64) -> Result<(), String> {
+pub fn field(path: &Path, title: &str, nx: usize, ny: usize, extent: [f64; 4], values: &[f32], vmax: f64) -> Result<(), PlotError> {
     fonts();
     let [x0, x1, y0, y1] = extent;
     let aspect = (y1 - y0) / (x1 - x0);
@@ -267,7 +279,7 @@ const PALETTE: [RGBColor; 8] = [
 ];
 
 /// Several lines in one panel with a legend (learning curves of several runs).
-pub fn lines(path: &Path, title: &str, x_label: &str, y_label: &str, lines: &[Line]) -> Result<(), String> {
+pub fn lines(path: &Path, title: &str, x_label: &str, y_label: &str, lines: &[Line]) -> Result<(), PlotError> {
     fonts();
     let root = BitMapBackend::new(path, (1100, 600)).into_drawing_area();
     root.fill(&WHITE).map_err(err(path))?;
@@ -358,7 +370,7 @@ fn y_hi<DB: DrawingBackend>(
 }
 
 /// Bars with error whiskers (a leaderboard per environment): `(label, mean, std)`.
-pub fn bars(path: &Path, title: &str, y_label: &str, bars: &[(String, f64, f64)]) -> Result<(), String> {
+pub fn bars(path: &Path, title: &str, y_label: &str, bars: &[(String, f64, f64)]) -> Result<(), PlotError> {
     use plotters::coord::ranged1d::SegmentValue;
     fonts();
     let root = BitMapBackend::new(path, (200 + 140 * bars.len().max(1) as u32, 600)).into_drawing_area();

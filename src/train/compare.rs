@@ -180,13 +180,19 @@ pub fn analyse(p: &Protocol, root: &Path, r0: f64) -> Result<Comparison, String>
         summary,
         sample_reduction_vs_reference,
     };
-    plot(p, &curves, threshold, r0, &root.join("learning_curves.png"))?;
+    plot(p, &curves, threshold, r0, &root.join("learning_curves.png")).map_err(|e| crate::report::chain(&e))?;
     Ok(cmp)
 }
 
 /// Mean +- std over seeds of each algorithm's evaluation return against samples (evaluations
 /// happen at the same sample counts for every seed of an algorithm).
-fn plot(p: &Protocol, curves: &[(String, u64, PathBuf, Vec<CurveRow>, f64)], threshold: f64, r0: f64, path: &Path) -> Result<(), String> {
+fn plot(
+    p: &Protocol,
+    curves: &[(String, u64, PathBuf, Vec<CurveRow>, f64)],
+    threshold: f64,
+    r0: f64,
+    path: &Path,
+) -> Result<(), crate::report::plots::PlotError> {
     let mut xs: Vec<Vec<f64>> = vec![];
     let mut ys: Vec<Vec<f64>> = vec![];
     let mut bands: Vec<Vec<f64>> = vec![];

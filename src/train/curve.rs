@@ -66,7 +66,7 @@ pub fn from_csv(text: &str) -> Result<Vec<CurveRow>, String> {
 
 /// `curve.png`: training and evaluation return against samples; `drag_reduction.png`: the
 /// evaluation drag reduction.
-pub fn plot(dir: &Path, title: &str, rows: &[CurveRow]) -> Result<(), String> {
+pub fn plot(dir: &Path, title: &str, rows: &[CurveRow]) -> Result<(), crate::report::plots::PlotError> {
     let x: Vec<f64> = rows.iter().map(|r| r.samples as f64).collect();
     let tr: Vec<f64> = rows.iter().map(|r| r.train_return).collect();
     let ev: Vec<f64> = rows.iter().map(|r| r.eval_return).collect();

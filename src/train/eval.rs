@@ -43,7 +43,7 @@ pub fn evaluate<E: Env + crate::env::fields::FlowFields + ?Sized>(
     progress: &mut dyn FnMut(usize),
 ) -> Result<EvalReport, EnvError> {
     let mut episodes = vec![];
-    let io = |e: String| EnvError::Backend(e);
+    let io = |e: crate::data::DataError| EnvError::Backend(crate::report::chain(&e));
     for (k, (seed, c_d0)) in seeds.iter().zip(reference).enumerate() {
         let mut cost = 0.0;
         let (mut obs, mut info) = env.reset(*seed)?;

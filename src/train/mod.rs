@@ -239,7 +239,7 @@ pub fn train(
         spec.trajectory_manifest(opts.level, algo.name(), &final_seeds)
             .map_err(|e| TrainError::Io(format!("cannot describe the spec: {e}")))?,
     )
-    .map_err(TrainError::Io)?
+    .map_err(|e| TrainError::Io(crate::report::chain(&e)))?
     .with_fields(config.train.fields_every);
     let report = evaluate(
         &mut eval_env,
@@ -253,14 +253,14 @@ pub fn train(
         Some(&mut trajectory),
         &mut |_| {},
     )?;
-    trajectory.finish().map_err(TrainError::Io)?;
+    trajectory.finish().map_err(|e| TrainError::Io(crate::report::chain(&e)))?;
     let io = |e: std::io::Error| TrainError::Io(format!("writing results to {}: {e}", opts.out.display()));
     let json = |v: &dyn erased::Json| v.to_json();
     std::fs::write(opts.out.join("policy.json"), json(&policy) + "\n").map_err(io)?;
     std::fs::write(opts.out.join("metrics.json"), json(&report) + "\n").map_err(io)?;
     std::fs::write(opts.out.join("curve.csv"), curve::to_csv(&curve)).map_err(io)?;
     let title = format!("{} {} seed {} ({})", spec.id(), algo.name(), opts.seed, opts.level.name());
-    curve::plot(&opts.out, &title, &curve).map_err(TrainError::Io)?;
+    curve::plot(&opts.out, &title, &curve).map_err(|e| TrainError::Io(crate::report::chain(&e)))?;
     let m = TrainManifest {
         schema: "hgym/train/v1".into(),
         env_id: spec.id().to_string(),

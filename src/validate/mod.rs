@@ -99,7 +99,7 @@ fn out_err(path: &Path) -> impl Fn(String) -> ValidateError + '_ {
 fn write_outputs(report: &ValidationReport, output: &run::RunOutput, out: &Path) -> Result<(), ValidateError> {
     let dir = out.join(&report.case);
     std::fs::create_dir_all(&dir).map_err(|e| out_err(&dir)(e.to_string()))?;
-    report::write_plots(report, output, &dir).map_err(out_err(&dir))?;
+    report::write_plots(report, output, &dir).map_err(|e| out_err(&dir)(crate::report::chain(&e)))?;
     let csv = dir.join("forces.csv");
     series::write_forces_csv(output, &csv).map_err(out_err(&csv))?;
     let json_path = out.join(format!("{}.json", report.case));

@@ -432,7 +432,7 @@ impl ValidationReport {
 }
 
 /// Force history (window marked), lift spectrum (measured and reference St marked), vorticity.
-pub fn write_plots(r: &ValidationReport, out: &RunOutput, dir: &Path) -> Result<(), String> {
+pub fn write_plots(r: &ValidationReport, out: &RunOutput, dir: &Path) -> Result<(), plots::PlotError> {
     let title = format!("{} ({} level): drag and lift", r.case, r.level);
     let window = (r.analysis.window[1] > r.analysis.window[0]).then_some(r.analysis.window);
     plots::time_series(
