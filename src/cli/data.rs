@@ -50,9 +50,9 @@ pub fn run_export(args: ExportArgs) -> Result<Outcome> {
         pretty_name: args.name.clone(),
         ..ExportOptions::default()
     };
-    let paths = hgym::data::hf::find_trajectories(&args.dir).map_err(UsageError)?;
+    let paths = hgym::data::hf::find_trajectories(&args.dir)?;
     let pb = super::progress::Progress::new(paths.len() as u64, "reading");
-    let report = export(&args.dir, &args.out, &opts, &mut |k, _| pb.set_position(k as u64)).map_err(UsageError)?;
+    let report = export(&args.dir, &args.out, &opts, &mut |k, _| pb.set_position(k as u64))?;
     pb.finish_and_clear();
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

@@ -160,6 +160,6 @@ mod tests {
             extent: [0.0; 4],
             fields: vec![("u".into(), vec![0.0; 3])],
         };
-        assert!(s.encode().unwrap_err().contains("has 3 values"));
+        assert!(s.encode().unwrap_err().to_string().contains("has 3 values"));
     }
 }

@@ -10,6 +10,7 @@
 //! environment's snapshots (`"<ENV>-fields"`). Files are read in path order, so the same input
 //! gives the same shards.
 
+use super::DataError;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -73,17 +74,17 @@ pub struct ExportReport {
 }
 
 /// Every `*.mcap` under `dir` (or `dir` itself if it is one), sorted.
-pub fn find_trajectories(dir: &Path) -> Result<Vec<PathBuf>, String> {
+pub fn find_trajectories(dir: &Path) -> Result<Vec<PathBuf>, DataError> {
     if dir.is_file() {
         return Ok(vec![dir.to_path_buf()]);
     }
     if !dir.is_dir() {
-        return Err(format!("{} does not exist", dir.display()));
+        return Err(DataError::Format(format!("{} does not exist", dir.display())));
     }
     let mut out = vec![];
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
-        let entries = std::fs::read_dir(&d).map_err(|e| format!("cannot list {}: {e}", d.display()))?;
+        let entries = std::fs::read_dir(&d).map_err(DataError::io(&d))?;
         for e in entries.flatten() {
             let p = e.path();
             if p.is_dir() {
@@ -95,10 +96,10 @@ pub fn find_trajectories(dir: &Path) -> Result<Vec<PathBuf>, String> {
     }
     out.sort();
     if out.is_empty() {
-        return Err(format!(
+        return Err(DataError::Format(format!(
             "no .mcap trajectory under {}: write some with `hgym run`, `hgym eval --out DIR` or `hgym train`",
             dir.display()
-        ));
+        )));
     }
     Ok(out)
 }
@@ -108,8 +109,8 @@ fn shard_name(k: usize, n: usize) -> String {
     format!("train-{k:05}-of-{n:05}.parquet")
 }
 
-fn write_shards(df: &polars::prelude::DataFrame, per: usize, dir: &Path, out: &Path, files: &mut Vec<String>) -> Result<(), String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+fn write_shards(df: &polars::prelude::DataFrame, per: usize, dir: &Path, out: &Path, files: &mut Vec<String>) -> Result<(), DataError> {
+    std::fs::create_dir_all(dir).map_err(DataError::io(dir))?;
     let rows = df.height();
     let n = rows.div_ceil(per.max(1)).max(1);
     for k in 0..n {
@@ -121,28 +122,28 @@ fn write_shards(df: &polars::prelude::DataFrame, per: usize, dir: &Path, out: &P
 }
 
 /// Refuses to overwrite a folder that is not an earlier export; clears an earlier export's data.
-fn prepare(out: &Path) -> Result<(), String> {
+fn prepare(out: &Path) -> Result<(), DataError> {
     if out.exists() {
         let is_export = out.join("hgym_export.json").exists();
         let empty = std::fs::read_dir(out).map(|mut d| d.next().is_none()).unwrap_or(false);
         if !is_export && !empty {
-            return Err(format!(
+            return Err(DataError::Format(format!(
                 "{} exists and is not an hgym export (no hgym_export.json): choose an empty or new folder",
                 out.display()
-            ));
+            )));
         }
         for sub in ["data", "fields"] {
             let p = out.join(sub);
             if p.exists() {
-                std::fs::remove_dir_all(&p).map_err(|e| format!("cannot clear {}: {e}", p.display()))?;
+                std::fs::remove_dir_all(&p).map_err(DataError::io(&p))?;
             }
         }
     }
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))
+    std::fs::create_dir_all(out).map_err(DataError::io(out))
 }
 
 /// Exports every trajectory under `dir` to the dataset folder `out`.
-pub fn export(dir: &Path, out: &Path, opts: &ExportOptions, progress: &mut dyn FnMut(usize, usize)) -> Result<ExportReport, String> {
+pub fn export(dir: &Path, out: &Path, opts: &ExportOptions, progress: &mut dyn FnMut(usize, usize)) -> Result<ExportReport, DataError> {
     let paths = find_trajectories(dir)?;
     let mut trajectories: Vec<(String, String, Trajectory)> = vec![];
     for (k, p) in paths.iter().enumerate() {
@@ -210,12 +211,10 @@ pub fn export(dir: &Path, out: &Path, opts: &ExportOptions, progress: &mut dyn F
     };
     let card = super::card::card(&report, &trajectories.iter().map(|(_, _, t)| t).collect::<Vec<_>>(), opts);
     let w = |name: &str, text: String| {
-        std::fs::write(out.join(name), text).map_err(|e| format!("cannot write {}: {e}", out.join(name).display()))
+        let path = out.join(name);
+        std::fs::write(&path, text).map_err(DataError::io(&path))
     };
     w("README.md", card)?;
-    w(
-        "hgym_export.json",
-        serde_json::to_string_pretty(&report).map_err(|e| e.to_string())? + "\n",
-    )?;
+    w("hgym_export.json", serde_json::to_string_pretty(&report)? + "\n")?;
     Ok(report)
 }

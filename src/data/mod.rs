@@ -28,6 +28,8 @@ pub enum DataError {
     Json(#[from] serde_json::Error),
     #[error("the trajectory writer is already finished")]
     Finished,
+    #[error("building or writing a table")]
+    Table(#[from] polars::error::PolarsError),
     /// Content that does not have the expected form (a file from elsewhere, or a damaged one).
     #[error("{0}")]
     Format(String),

@@ -3,6 +3,7 @@
 //! `/obs`, `/action`, `/reward` and `/info` messages of that step; the `manifest` metadata
 //! record; the flow-field snapshots of `/field` (see [`super::field`]).
 
+use super::DataError;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -57,14 +58,14 @@ fn numbers(v: &Value) -> Vec<f64> {
 }
 
 /// Reads a complete (or `hgym data recover`-ed) trajectory file.
-pub fn read(path: &Path) -> Result<Trajectory, String> {
-    let buf = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+pub fn read(path: &Path) -> Result<Trajectory, DataError> {
+    let buf = std::fs::read(path).map_err(DataError::io(path))?;
     let bad = |e: &dyn std::fmt::Display| {
-        format!(
+        DataError::Format(format!(
             "{} is not a readable MCAP file ({e}); if a run was killed, `hgym data recover {}` salvages it",
             path.display(),
             path.display()
-        )
+        ))
     };
     let mut manifest = BTreeMap::new();
     let summary = mcap::Summary::read(&buf).map_err(|e| bad(&e))?;

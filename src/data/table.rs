@@ -4,6 +4,7 @@
 //! reset, step 0), `reward` (null at step 0), `terminated`, `truncated`, then every numeric info
 //! value under its snake-case name (`c_d`, `c_l`, `abs_c_l`, `actuation_0`, ...).
 
+use super::DataError;
 use std::collections::BTreeSet;
 
 use polars::prelude::*;
@@ -49,7 +50,7 @@ fn list(name: &str, rows: Vec<Option<Vec<f64>>>) -> Column {
 }
 
 /// The step table of `sources` (in the given order, rows in (episode, step) order).
-pub fn steps(sources: &[Source]) -> Result<DataFrame, String> {
+pub fn steps(sources: &[Source]) -> Result<DataFrame, DataError> {
     let info_keys: BTreeSet<String> = sources
         .iter()
         .flat_map(|s| s.trajectory.rows.iter().flat_map(|r| r.info.keys().cloned()))
@@ -57,7 +58,10 @@ pub fn steps(sources: &[Source]) -> Result<DataFrame, String> {
         .collect();
     for k in &info_keys {
         if FIXED.contains(&column_name(k).as_str()) {
-            return Err(format!("info value '{k}' would shadow the column '{}'", column_name(k)));
+            return Err(DataError::Format(format!(
+                "info value '{k}' would shadow the column '{}'",
+                column_name(k)
+            )));
         }
     }
     let n: usize = sources.iter().map(|s| s.trajectory.rows.len()).sum();
@@ -106,13 +110,13 @@ pub fn steps(sources: &[Source]) -> Result<DataFrame, String> {
     for (k, col) in info_keys.iter().zip(info) {
         columns.push(Column::new(column_name(k).into(), col));
     }
-    DataFrame::new(n, columns).map_err(|e| format!("building the step table: {e}"))
+    Ok(DataFrame::new(n, columns)?)
 }
 
 /// The snapshot table: `run`, `env_id`, `episode`, `step`, `t`, `nx`, `ny`, `extent`
 /// (x0, x1, y0, y1) and one float32 list column per field (`u`, `v`, `vorticity`), row-major
 /// `f[y * nx + x]`.
-pub fn fields(sources: &[Source]) -> Result<Option<DataFrame>, String> {
+pub fn fields(sources: &[Source]) -> Result<Option<DataFrame>, DataError> {
     let names: BTreeSet<String> = sources
         .iter()
         .flat_map(|s| s.trajectory.fields.iter().flat_map(|f| f.fields.iter().map(|(n, _)| n.clone())))
@@ -157,17 +161,14 @@ pub fn fields(sources: &[Source]) -> Result<Option<DataFrame>, String> {
     for (name, col) in names.iter().zip(values) {
         columns.push(Series::new(column_name(name).into(), col).into_column());
     }
-    DataFrame::new(n, columns)
-        .map(Some)
-        .map_err(|e| format!("building the field table: {e}"))
+    Ok(Some(DataFrame::new(n, columns)?))
 }
 
 /// Writes `df` rows `[start, start + len)` as a zstd-compressed Parquet file.
-pub fn write_parquet(df: &DataFrame, start: usize, len: usize, path: &std::path::Path) -> Result<u64, String> {
+pub fn write_parquet(df: &DataFrame, start: usize, len: usize, path: &std::path::Path) -> Result<u64, DataError> {
     let mut part = df.slice(start as i64, len);
-    let file = std::fs::File::create(path).map_err(|e| format!("cannot create {}: {e}", path.display()))?;
-    ParquetWriter::new(file)
+    let file = std::fs::File::create(path).map_err(DataError::io(path))?;
+    Ok(ParquetWriter::new(file)
         .with_compression(ParquetCompression::Zstd(None))
-        .finish(&mut part)
-        .map_err(|e| format!("writing {}: {e}", path.display()))
+        .finish(&mut part)?)
 }
