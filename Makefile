@@ -12,12 +12,13 @@ LEVEL ?= default
 VENV ?= $(HOME)/.cache/hgym-venv
 PYTHON ?= python3
 
-.PHONY: all setup build test validate bench nightly lint fmt clean help leaderboard peers
+.PHONY: all setup build test validate bench nightly lint fmt clean help leaderboard peers roofline
 
 help:
 	@echo "make validate   build, then validate the D2Q9 solver on the cylinder at Re 100 (LEVEL=$(LEVEL); the rest: make nightly)"
 	@echo "make test       unit, exact-solution, CLI and schema tests (coarse, fast)"
 	@echo "make bench      hgym bench lbm: MLUPS against the measured memory bandwidth"
+	@echo "make roofline   hgym's copy bandwidth (the bench's roofline) beside STREAM's C copy, alternating"
 	@echo "make nightly    validations (default level), benchmarks, short trainings, leaderboard; results/nightly/summary.md"
 	@echo "make peers      install the peers hgym bench --peer runs beside ours (SB3, hydrogym[jax]; ~7 GB)"
 	@echo "make lint       rustfmt and clippy"
@@ -64,6 +65,14 @@ validate: build
 
 bench: build
 	$(HGYM) bench lbm
+
+# The roofline check: hgym's copy loop against STREAM's C copy compiled here, same threads,
+# alternating pairs (bandwidth drifts by +-20 % from minute to minute).
+$(CARGO_TARGET_DIR)/stream_copy: benchmarks/stream/copy.c
+	$(CC) -O3 -march=native -fopenmp $< -o $@
+
+roofline: build $(CARGO_TARGET_DIR)/stream_copy
+	HGYM=$(HGYM) C_COPY=$(CARGO_TARGET_DIR)/stream_copy scripts/roofline.sh
 
 nightly: build
 	HGYM=$(HGYM) scripts/nightly.sh

@@ -127,26 +127,37 @@ fn main() -> ExitCode {
         Ok(Outcome::CheckFailed) => ExitCode::from(1),
         Err(e) => {
             eprintln!("error: {e:#}");
-            let bad_input = e.chain().any(|c| {
-                c.downcast_ref::<ValidateError>().is_some_and(|v| v.is_bad_input())
-                    || c.downcast_ref::<hgym::fidelity::FidelityError>().is_some_and(|v| v.is_bad_input())
-                    || c.downcast_ref::<UsageError>().is_some()
-                    || c.downcast_ref::<hgym::env::EnvInputError>().is_some()
-                    || matches!(c.downcast_ref::<hgym::data::DataError>(), Some(hgym::data::DataError::Format(_)))
-                    || matches!(
-                        c.downcast_ref::<hgym_agents::EnvError>(),
-                        Some(hgym_agents::EnvError::InvalidSpec(_))
-                    )
-                    || matches!(
-                        c.downcast_ref::<hgym::train::TrainError>(),
-                        Some(hgym::train::TrainError::Input(_) | hgym::train::TrainError::Env(hgym_agents::EnvError::InvalidSpec(_)))
-                    )
-            });
-            ExitCode::from(if bad_input { 2 } else { 1 })
+            ExitCode::from(if is_bad_input(&e) { 2 } else { 1 })
         }
     }
 }
 
+/// The one place that decides the exit code of an error: 2 when anything in its chain is the
+/// user's input (an unknown name, a malformed file, a spec that cannot run), else 1.
+fn is_bad_input(e: &anyhow::Error) -> bool {
+    use hgym_agents::EnvError;
+    e.chain().any(|c| {
+        c.downcast_ref::<UsageError>().is_some()
+            || c.downcast_ref::<hgym::env::EnvInputError>().is_some()
+            || c.downcast_ref::<hgym::train::config::ConfigError>().is_some()
+            || c.downcast_ref::<hgym::train::curve::CurveFormatError>().is_some()
+            || matches!(
+                c.downcast_ref::<hgym::train::eval::PolicyError>(),
+                Some(hgym::train::eval::PolicyError::Invalid(_))
+            )
+            || c.downcast_ref::<ValidateError>().is_some_and(|v| v.is_bad_input())
+            || c.downcast_ref::<hgym::fidelity::FidelityError>().is_some_and(|v| v.is_bad_input())
+            || c.downcast_ref::<hgym::train::TrainError>().is_some_and(|t| t.is_bad_input())
+            || c.downcast_ref::<hgym::train::checkpoint::CheckpointError>()
+                .is_some_and(|t| t.is_bad_input())
+            || c.downcast_ref::<hgym::train::compare::CompareError>()
+                .is_some_and(|t| t.is_bad_input())
+            || matches!(c.downcast_ref::<hgym::data::DataError>(), Some(hgym::data::DataError::Format(_)))
+            || matches!(c.downcast_ref::<EnvError>(), Some(EnvError::InvalidSpec(_)))
+    })
+}
+
+/// A command-line mistake the CLI itself finds (exit code 2).
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
 struct UsageError(String);

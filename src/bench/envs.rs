@@ -35,7 +35,7 @@ pub fn bench_envs(
     families: &[String],
     cache: Option<std::path::PathBuf>,
     progress: &mut dyn FnMut(&str),
-) -> Result<Vec<EnvBenchRow>, String> {
+) -> Result<Vec<EnvBenchRow>, hgym_agents::EnvError> {
     let mut seen = std::collections::BTreeSet::new();
     let mut rows = Vec::new();
     for spec in registry::lbm_specs() {
@@ -46,16 +46,16 @@ pub fn bench_envs(
             continue;
         }
         for &level in levels {
-            let mut env = LbmEnv::new(spec.clone(), level, cache.clone()).map_err(|e| e.to_string())?;
+            let mut env = LbmEnv::new(spec.clone(), level, cache.clone())?;
             progress(&format!("{} ({}): reset", spec.id, level.name()));
-            env.reset(0).map_err(|e| e.to_string())?;
+            env.reset(0)?;
             let dim = spec.act_dim();
             let t = Instant::now();
             for k in 0..actions {
                 let a = if k % 2 == 0 { 0.5 } else { -0.5 };
-                let r = env.step(&vec![a; dim]).map_err(|e| e.to_string())?;
+                let r = env.step(&vec![a; dim])?;
                 if r.terminated || r.truncated {
-                    env.reset(k as u64).map_err(|e| e.to_string())?;
+                    env.reset(k as u64)?;
                 }
             }
             let dt = t.elapsed().as_secs_f64();

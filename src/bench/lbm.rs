@@ -6,6 +6,8 @@ use hgym_solvers::lbm::lattice::BYTES_PER_CELL_F32;
 use hgym_solvers::lbm::{Collision, D2q9, D2q9Config, Sides};
 use serde::{Deserialize, Serialize};
 
+use super::BenchError;
+
 use super::stream::stream_copy_gbs;
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -66,12 +68,12 @@ impl Default for LbmBenchOptions {
 
 /// Taylor-Green vortex on an `nx x ny` periodic grid; returns the solver and the exact velocity
 /// amplitude decay rate.
-fn taylor_green(nx: usize, ny: usize, collision: Collision) -> Result<(D2q9, f64, f64, f64), String> {
+fn taylor_green(nx: usize, ny: usize, collision: Collision) -> Result<(D2q9, f64, f64, f64), BenchError> {
     let tau = 0.6;
     let mut cfg = D2q9Config::new(nx, ny, tau, Sides::periodic());
     cfg.collision = collision;
     cfg.check_interval = 0;
-    let mut s = D2q9::new(cfg, vec![]).map_err(|e| e.to_string())?;
+    let mut s = D2q9::new(cfg, vec![])?;
     let (kx, ky) = (2.0 * std::f64::consts::PI / nx as f64, 2.0 * std::f64::consts::PI / ny as f64);
     let u0 = 0.02;
     s.init_with(|x, y| {
@@ -87,31 +89,28 @@ fn taylor_green(nx: usize, ny: usize, collision: Collision) -> Result<(D2q9, f64
 
 /// Runs the benchmark; every size is checked against the exact Taylor-Green decay before the
 /// timing counts.
-pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Result<BenchReport, String> {
+pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Result<BenchReport, BenchError> {
     let mut rows = Vec::new();
     let n_sizes = opts.sizes.len();
     for &threads in &opts.threads {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .map_err(|e| e.to_string())?;
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
         for (k, &(nx, ny)) in opts.sizes.iter().enumerate() {
             // The copy is measured right before each row (best of 5), and the kernel is timed as
             // the best of 3 runs, so both see the machine in the same state (this VM's
             // bandwidth moves by +-20 % between minutes).
             let copy_gbs = pool.install(|| stream_copy_gbs(opts.stream_values, 5));
-            let row = pool.install(|| -> Result<BenchRow, String> {
+            let row = pool.install(|| -> Result<BenchRow, BenchError> {
                 let (mut s, rate, kx, ky) = taylor_green(nx, ny, opts.collision)?;
-                s.advance(3).map_err(|e| e.to_string())?;
+                s.advance(3)?;
                 // Calibrate the step count to the time budget.
                 let t = Instant::now();
-                s.advance(3).map_err(|e| e.to_string())?;
+                s.advance(3)?;
                 let per_step = t.elapsed().as_secs_f64() / 3.0;
                 let steps = ((opts.seconds / 3.0 / per_step.max(1e-9)) as u64).max(3);
                 let mut dt = f64::INFINITY;
                 for _ in 0..3 {
                     let t = Instant::now();
-                    s.advance(steps).map_err(|e| e.to_string())?;
+                    s.advance(steps)?;
                     dt = dt.min(t.elapsed().as_secs_f64());
                 }
                 // Check: velocity against the exact decay u0 exp(-nu k^2 t).
@@ -144,10 +143,10 @@ pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Resu
                 })
             })?;
             if row.check_error > 0.01 {
-                return Err(format!(
-                    "correctness check failed at {nx} x {ny}: Taylor-Green velocity off by {:.2e} of its amplitude",
+                return Err(BenchError::Check(format!(
+                    "{nx} x {ny}: Taylor-Green velocity off by {:.2e} of its amplitude",
                     row.check_error
-                ));
+                )));
             }
             progress(&format!(
                 "{nx} x {ny}, {threads} thread(s): {:.0} MLUPS ({:.0} % of roofline)",

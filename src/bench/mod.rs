@@ -21,6 +21,20 @@ pub mod peer;
 mod refine;
 mod stream;
 
+/// Why a speed benchmark could not report.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    #[error(transparent)]
+    Solver(#[from] hgym_solvers::lbm::LbmError),
+    /// The kernel gave a wrong answer on the correctness check that precedes every timing.
+    #[error("correctness check failed: {0}")]
+    Check(String),
+    #[error("{0}")]
+    Input(String),
+    #[error("cannot start the worker threads")]
+    Threads(#[from] rayon::ThreadPoolBuildError),
+}
+
 pub use lbm::{bench_lbm, BenchReport, BenchRow, LbmBenchOptions};
 pub use refine::{bench_refine, RefineBenchOptions, RefineBenchReport, RefineBenchRow};
 pub use stream::stream_copy_gbs;

@@ -13,6 +13,8 @@ use std::time::Instant;
 use hgym_solvers::lbm::{Collision, D2q9, D2q9Config, Patch, Refined, Sides};
 use serde::{Deserialize, Serialize};
 
+use super::BenchError;
+
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct RefineBenchRow {
     pub threads: usize,
@@ -99,7 +101,7 @@ fn check(grid: &D2q9, origin: f64, dx: f64, n: usize, t: f64) -> f64 {
 
 /// Steps `step` for about `seconds` (best of three timings after a calibration); returns steps
 /// per second.
-fn time_steps(seconds: f64, mut step: impl FnMut(u64) -> Result<(), String>) -> Result<f64, String> {
+fn time_steps(seconds: f64, mut step: impl FnMut(u64) -> Result<(), hgym_solvers::lbm::LbmError>) -> Result<f64, BenchError> {
     step(2)?;
     let t = Instant::now();
     step(2)?;
@@ -115,10 +117,10 @@ fn time_steps(seconds: f64, mut step: impl FnMut(u64) -> Result<(), String>) -> 
 }
 
 /// Runs the benchmark (regularised collision, the validation cases' operator).
-pub fn bench_refine(opts: &RefineBenchOptions, progress: &mut dyn FnMut(&str)) -> Result<RefineBenchReport, String> {
+pub fn bench_refine(opts: &RefineBenchOptions, progress: &mut dyn FnMut(&str)) -> Result<RefineBenchReport, BenchError> {
     let n = opts.n;
     if n < 64 || !n.is_multiple_of(16) {
-        return Err(format!("grid side {n}: use a multiple of 16, at least 64"));
+        return Err(BenchError::Input(format!("grid side {n}: use a multiple of 16, at least 64")));
     }
     let cfg = || {
         let mut c = D2q9Config::new(n, n, TAU, Sides::periodic());
@@ -132,20 +134,17 @@ pub fn bench_refine(opts: &RefineBenchOptions, progress: &mut dyn FnMut(&str)) -
     };
     let mut rows = Vec::new();
     for &threads in &opts.threads {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .map_err(|e| e.to_string())?;
-        let row = pool.install(|| -> Result<RefineBenchRow, String> {
-            let mut uniform = D2q9::new(cfg(), vec![]).map_err(|e| e.to_string())?;
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
+        let row = pool.install(|| -> Result<RefineBenchRow, BenchError> {
+            let mut uniform = D2q9::new(cfg(), vec![])?;
             uniform.init_with(|x, y| vortex(n, 0.0, x, y));
-            let uniform_rate = time_steps(opts.seconds, |k| uniform.advance(k).map_err(|e| e.to_string()))?;
+            let uniform_rate = time_steps(opts.seconds, |k| uniform.advance(k))?;
             let uniform_mlups = uniform_rate * (n * n) as f64 / 1e6;
             drop(uniform);
 
-            let mut refined = Refined::new(cfg(), &[patch], vec![]).map_err(|e| e.to_string())?;
+            let mut refined = Refined::new(cfg(), &[patch], vec![])?;
             refined.init_with(|x, y| vortex(n, 0.0, x, y));
-            let rate = time_steps(opts.seconds, |k| refined.advance(k).map_err(|e| e.to_string()))?;
+            let rate = time_steps(opts.seconds, |k| refined.advance(k))?;
             let updates = refined.node_updates_per_step();
             let refined_mlups = rate * updates as f64 / 1e6;
             refined.sync();
@@ -165,10 +164,10 @@ pub fn bench_refine(opts: &RefineBenchOptions, progress: &mut dyn FnMut(&str)) -
             })
         })?;
         if row.check_error.iter().any(|e| *e > 0.01) {
-            return Err(format!(
-                "correctness check failed: Taylor-Green velocity off by {:.2e} (coarse) / {:.2e} (patch) of its amplitude",
+            return Err(BenchError::Check(format!(
+                "Taylor-Green velocity off by {:.2e} (coarse) / {:.2e} (patch) of its amplitude",
                 row.check_error[0], row.check_error[1]
-            ));
+            )));
         }
         progress(&format!(
             "{threads} thread(s): uniform {:.0} MLUPS, refined {:.0} MLUPS ({:.0} %)",

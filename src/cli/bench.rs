@@ -36,6 +36,18 @@ pub enum BenchCommand {
         #[arg(long)]
         quick: bool,
     },
+    /// The copy bandwidth `hgym bench lbm` takes as the machine's limit (STREAM copy, GB/s, read
+    /// + write), alone: `make roofline` runs it beside STREAM's C copy to check it is as fast.
+    Copy {
+        /// Print one JSON line.
+        #[arg(long)]
+        json: bool,
+        #[arg(long)]
+        threads: Option<usize>,
+        /// f32 values per array (default 2^26: 256 MB each).
+        #[arg(long, default_value_t = 1 << 26)]
+        values: usize,
+    },
     /// Learner speed: TD3 updates/s (256x256, batch 256), PPO epochs/s (64x64), batch-1 policy
     /// latency. With --peer, Stable-Baselines3's TD3 at the same shapes is timed in the same run,
     /// alternating with ours, and the ratios printed; without it, no ratio. Exit 1 if a policy
@@ -100,6 +112,19 @@ pub fn run(cmd: BenchCommand) -> Result<Outcome> {
     match cmd {
         BenchCommand::Lbm { json, quick, collision } => run_bench(json, quick, collision),
         BenchCommand::Refine { json, quick } => run_bench_refine(json, quick),
+        BenchCommand::Copy { json, threads, values } => {
+            if values < 1 << 20 {
+                return Err(UsageError("--values must be at least 1048576 (arrays far beyond the caches)".into()).into());
+            }
+            let (pool, n) = thread_pool(threads)?;
+            let gbs = pool.install(|| hgym::bench::stream_copy_gbs(values, 10));
+            if json {
+                println!("{}", serde_json::json!({"threads": n, "copy_gbs": gbs}));
+            } else {
+                println!("STREAM copy, {n} thread(s), 2 x {} MB: {gbs:.2} GB/s", values * 4 >> 20);
+            }
+            Ok(Outcome::Ok)
+        }
         BenchCommand::Envs {
             json,
             actions,
@@ -157,7 +182,7 @@ fn run_bench(json: bool, quick: bool, collision: CollisionArg) -> Result<Outcome
             eprintln!("{msg}");
         }
     })
-    .map_err(anyhow::Error::msg)
+    .map_err(anyhow::Error::from)
     .context("LBM benchmark")?;
     print_report(json, &report, &report.table())?;
     Ok(if report.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
@@ -174,7 +199,7 @@ fn run_bench_refine(json: bool, quick: bool) -> Result<Outcome> {
             eprintln!("{msg}");
         }
     })
-    .map_err(anyhow::Error::msg)
+    .map_err(anyhow::Error::from)
     .context("refinement benchmark")?;
     print_report(json, &report, &report.table())?;
     Ok(if report.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
@@ -198,7 +223,7 @@ fn run_bench_envs(json: bool, actions: usize, quick: bool, families: &[String]) 
             eprintln!("{m}");
         }
     })
-    .map_err(anyhow::Error::msg)
+    .map_err(anyhow::Error::from)
     .context("environment benchmark")?;
     if json {
         println!("{}", serde_json::to_string_pretty(&rows)?);

@@ -117,7 +117,7 @@ fn run_plot(runs: &[PathBuf], out: &std::path::Path, drag: bool, train: bool) ->
     } else {
         "evaluation return"
     };
-    lines(out, "learning curves", "environment samples", what, &lines_).map_err(anyhow::Error::msg)?;
+    lines(out, "learning curves", "environment samples", what, &lines_).map_err(anyhow::Error::from)?;
     println!("wrote {} ({} runs)", out.display(), series.len());
     Ok(Outcome::Ok)
 }

@@ -45,7 +45,7 @@ pub fn run(args: RunArgs) -> Result<Outcome> {
         None => hgym::train::config::TrainConfig::default(),
         Some(p) => {
             let text = std::fs::read_to_string(p).with_context(|| format!("cannot read the config file {}", p.display()))?;
-            hgym::train::config::TrainConfig::parse(&text, &p.display().to_string()).map_err(UsageError)?
+            hgym::train::config::TrainConfig::parse(&text, &p.display().to_string())?
         }
     };
     let spec = match hgym::train::resolve_spec(&args.env, &config) {

@@ -118,7 +118,7 @@ fn load_config(path: Option<&Path>) -> Result<TrainConfig> {
         None => Ok(TrainConfig::default()),
         Some(p) => {
             let text = std::fs::read_to_string(p).with_context(|| format!("cannot read the config file {}", p.display()))?;
-            TrainConfig::parse(&text, &p.display().to_string()).map_err(|e| UsageError(e).into())
+            TrainConfig::parse(&text, &p.display().to_string()).map_err(anyhow::Error::from)
         }
     }
 }
@@ -328,7 +328,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
     }
     let config = load_config(args.config.as_deref())?;
     let spec = resolve_spec(&args.env, &config).map_err(train_error)?;
-    let named = parse_policy(&args.policy).map_err(UsageError)?;
+    let named = parse_policy(&args.policy)?;
     let (mut policy, name): (Box<dyn Policy + Send>, String) = match named {
         NamedPolicy::Trained(p) => {
             if p.obs_dim() != spec.obs_dim() || p.act_dim() != spec.act_dim() {
@@ -371,7 +371,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
                     spec.control_interval(),
                     spec.trajectory_manifest(args.level, &args.policy, &seeds)?,
                 )
-                .map_err(anyhow::Error::msg)?
+                .map_err(anyhow::Error::from)?
                 .with_fields(args.fields_every),
             )
         }
@@ -482,7 +482,7 @@ pub struct CompareArgs {
 /// `hgym compare`: every (algorithm, seed) of a protocol, then samples-to-threshold.
 pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
     use hgym::train::compare::{analyse, uncontrolled_return, Protocol};
-    let p = Protocol::load(&args.protocol).map_err(UsageError)?;
+    let p = Protocol::load(&args.protocol)?;
     let spec = resolve_spec(&p.env, &p.config).map_err(train_error)?;
     for name in &p.algos {
         if algorithm(name).is_ok_and(|a| a.needs_gradients()) && !spec.differentiable() {
@@ -506,7 +506,7 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
                     continue;
                 }
                 let resume = if dir.join(hgym::train::checkpoint::FILE).exists() {
-                    Some(hgym::train::checkpoint::load(&dir).map_err(UsageError)?)
+                    Some(hgym::train::checkpoint::load(&dir)?)
                 } else {
                     None
                 };
@@ -545,8 +545,8 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
             }
         }
     }
-    let r0 = pool.install(|| uncontrolled_return(&p)).map_err(anyhow::Error::msg)?;
-    let cmp = analyse(&p, &root, r0).map_err(anyhow::Error::msg)?;
+    let r0 = pool.install(|| uncontrolled_return(&p))?;
+    let cmp = analyse(&p, &root, r0)?;
     std::fs::create_dir_all(&root)?;
     std::fs::write(root.join("comparison.json"), serde_json::to_string_pretty(&cmp)? + "\n")?;
     if args.json {

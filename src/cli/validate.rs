@@ -61,7 +61,7 @@ pub fn run(args: ValidateArgs) -> Result<Outcome> {
     }
     if args.names == ["kolmogorov"] {
         let (pool, _) = thread_pool(args.threads)?;
-        let case = hgym::fidelity::kolmogorov::case().map_err(UsageError)?;
+        let case = hgym::fidelity::kolmogorov::case().context("the bundled case benchmarks/validation/kolmogorov_re40.toml")?;
         let pb = Progress::new((case.time / case.sample_interval) as u64, "kolmogorov Re 40");
         let r = pool
             .install(|| hgym::fidelity::kolmogorov::validate(args.level, &args.out, &mut |k, _| pb.set_position(k as u64)))

@@ -47,8 +47,8 @@ pub fn table() -> &'static BTreeMap<String, Entry> {
 }
 
 /// Parses a table; a malformed one yields an error naming the problem.
-pub fn parse_table(text: &str) -> Result<BTreeMap<String, Entry>, String> {
-    toml::from_str(text).map_err(|e| format!("benchmarks/envs/normalization.toml: {e}"))
+pub fn parse_table(text: &str) -> Result<BTreeMap<String, Entry>, crate::report::table::TableError> {
+    crate::report::table::parse(text, std::path::Path::new(TABLE_PATH))
 }
 
 /// The table key of `id`'s statistics at `level`: the ID itself for the default level (the

@@ -43,8 +43,8 @@ pub struct Case {
     pub checks: Checks,
 }
 
-pub fn case() -> Result<Case, String> {
-    toml::from_str(CASE).map_err(|e| format!("benchmarks/validation/kolmogorov_re40.toml: {e}"))
+pub fn case() -> Result<Case, toml::de::Error> {
+    toml::from_str(CASE)
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -71,7 +71,7 @@ pub struct KolmogorovValidation {
 /// `<out>/<case>/dissipation.png`.
 pub fn validate(level: Level, out: &Path, progress: &mut dyn FnMut(usize, usize)) -> Result<KolmogorovValidation, EnvError> {
     let started = std::time::Instant::now();
-    let c = case().map_err(EnvError::Backend)?;
+    let c = case().map_err(|e| EnvError::Backend(format!("the bundled case kolmogorov_re40.toml: {e}")))?;
     let time = c.time;
     let mut s = spec(c.reynolds);
     s.control_interval = c.sample_interval;

@@ -3,7 +3,7 @@
 //! rename), so a kill at any moment leaves either the previous or the new checkpoint intact.
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
@@ -35,8 +35,45 @@ pub struct Checkpoint {
     pub resumed: u32,
 }
 
-pub fn save(dir: &Path, ck: &Checkpoint) -> Result<(), String> {
-    let bytes = bincode::serialize(ck).map_err(|e| format!("cannot encode the checkpoint: {e}"))?;
+/// Why a checkpoint could not be written or read back.
+#[derive(Debug, thiserror::Error)]
+pub enum CheckpointError {
+    #[error("cannot read {} (is this a training result folder?)", path.display())]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("cannot write {}", path.display())]
+    Write {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{} is damaged or from another hgym version", path.display())]
+    Decode {
+        path: PathBuf,
+        #[source]
+        source: bincode::Error,
+    },
+    #[error("cannot encode the checkpoint")]
+    Encode(#[source] bincode::Error),
+    #[error("{} has checkpoint format {found}, this hgym reads {FORMAT}", path.display())]
+    Format { path: PathBuf, found: u32 },
+}
+
+impl CheckpointError {
+    /// Whether the error is the user's input (a folder that holds no readable checkpoint).
+    pub fn is_bad_input(&self) -> bool {
+        matches!(
+            self,
+            CheckpointError::Read { .. } | CheckpointError::Decode { .. } | CheckpointError::Format { .. }
+        )
+    }
+}
+
+pub fn save(dir: &Path, ck: &Checkpoint) -> Result<(), CheckpointError> {
+    let bytes = bincode::serialize(ck).map_err(CheckpointError::Encode)?;
     let path = dir.join(FILE);
     let tmp = dir.join(format!("{FILE}.tmp"));
     let write = || -> std::io::Result<()> {
@@ -45,20 +82,21 @@ pub fn save(dir: &Path, ck: &Checkpoint) -> Result<(), String> {
         f.sync_all()?;
         std::fs::rename(&tmp, &path)
     };
-    write().map_err(|e| format!("cannot write {}: {e}", path.display()))
+    write().map_err(|source| CheckpointError::Write { path, source })
 }
 
-pub fn load(dir: &Path) -> Result<Checkpoint, String> {
+pub fn load(dir: &Path) -> Result<Checkpoint, CheckpointError> {
     let path = dir.join(FILE);
-    let bytes = std::fs::read(&path).map_err(|e| format!("cannot read {} ({e}): is this a training result folder?", path.display()))?;
-    let ck: Checkpoint =
-        bincode::deserialize(&bytes).map_err(|e| format!("{} is damaged or from another hgym version: {e}", path.display()))?;
+    let bytes = match std::fs::read(&path) {
+        Ok(b) => b,
+        Err(source) => return Err(CheckpointError::Read { path, source }),
+    };
+    let ck: Checkpoint = match bincode::deserialize(&bytes) {
+        Ok(ck) => ck,
+        Err(source) => return Err(CheckpointError::Decode { path, source }),
+    };
     if ck.format != FORMAT {
-        return Err(format!(
-            "{} has checkpoint format {}, this hgym reads {FORMAT}",
-            path.display(),
-            ck.format
-        ));
+        return Err(CheckpointError::Format { path, found: ck.format });
     }
     Ok(ck)
 }

@@ -38,17 +38,46 @@ pub struct Protocol {
     pub config: TrainConfig,
 }
 
+/// Why a comparison could not be set up or analysed.
+#[derive(Debug, thiserror::Error)]
+pub enum CompareError {
+    #[error("cannot read {}", path.display())]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A protocol file or a run's curve that does not have the expected content (bad input).
+    #[error("{}: {message}", path.display())]
+    Invalid { path: PathBuf, message: String },
+    #[error(transparent)]
+    Plot(#[from] plots::PlotError),
+}
+
+impl CompareError {
+    pub fn is_bad_input(&self) -> bool {
+        matches!(self, CompareError::Invalid { .. })
+    }
+}
+
 impl Protocol {
-    pub fn load(path: &Path) -> Result<Protocol, String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-        let mut p: Protocol = toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    pub fn load(path: &Path) -> Result<Protocol, CompareError> {
+        let invalid = |message: String| CompareError::Invalid {
+            path: path.to_path_buf(),
+            message,
+        };
+        let text = std::fs::read_to_string(path).map_err(|source| CompareError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let mut p: Protocol = toml::from_str(&text).map_err(|e| invalid(e.to_string()))?;
         for name in p.algos.iter().chain([&p.reference]) {
-            hgym_agents::learn::algorithm(name).map_err(|e| format!("{}: {e}", path.display()))?;
+            hgym_agents::learn::algorithm(name).map_err(|e| invalid(e.to_string()))?;
         }
         if !p.algos.contains(&p.reference) {
-            return Err(format!("{}: the reference '{}' is not among algos", path.display(), p.reference));
+            return Err(invalid(format!("the reference '{}' is not among algos", p.reference)));
         }
-        p.config.algos = p.config.algos.complete().map_err(|e| format!("{}: {e}", path.display()))?;
+        p.config.algos = p.config.algos.complete().map_err(|e| invalid(e.to_string()))?;
         Ok(p)
     }
 }
@@ -88,9 +117,9 @@ pub struct Comparison {
 }
 
 /// Return of the zero policy on the protocol's evaluation episodes.
-pub fn uncontrolled_return(p: &Protocol) -> Result<f64, String> {
-    let spec = super::resolve_spec(&p.env, &p.config).map_err(|e| e.to_string())?;
-    let mut env = spec.make(p.level, crate::env::default_cache_dir()).map_err(|e| e.to_string())?;
+pub fn uncontrolled_return(p: &Protocol) -> Result<f64, super::TrainError> {
+    let spec = super::resolve_spec(&p.env, &p.config)?;
+    let mut env = spec.make(p.level, crate::env::default_cache_dir())?;
     let n = p.config.train.eval_episodes.max(1);
     let seeds: Vec<u64> = (0..n as u64).map(|k| p.config.train.eval_seed + k).collect();
     let mut zero = hgym_agents::baselines::BaselinePolicy::new(hgym_agents::baselines::Baseline::Zero, 0);
@@ -107,8 +136,7 @@ pub fn uncontrolled_return(p: &Protocol) -> Result<f64, String> {
         &refs,
         None,
         &mut |_| {},
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     Ok(r.ret.mean)
 }
 
@@ -121,13 +149,17 @@ fn final_eval(rows: &[CurveRow]) -> f64 {
 }
 
 /// Reads the finished runs under `root/<algo>/seed<S>` and computes the comparison.
-pub fn analyse(p: &Protocol, root: &Path, r0: f64) -> Result<Comparison, String> {
+pub fn analyse(p: &Protocol, root: &Path, r0: f64) -> Result<Comparison, CompareError> {
     let mut curves: Vec<(String, u64, PathBuf, Vec<CurveRow>, f64)> = vec![];
     for algo in &p.algos {
         for seed in &p.seeds {
             let dir = root.join(algo).join(format!("seed{seed}"));
-            let text = std::fs::read_to_string(dir.join("curve.csv")).map_err(|e| format!("{}: {e}", dir.display()))?;
-            let rows = from_csv(&text)?;
+            let path = dir.join("curve.csv");
+            let text = std::fs::read_to_string(&path).map_err(|source| CompareError::Read {
+                path: path.clone(),
+                source,
+            })?;
+            let rows = from_csv(&text).map_err(|e| CompareError::Invalid { path, message: e.0 })?;
             let wall = rows.last().map(|r| r.wall_s).unwrap_or(f64::NAN);
             curves.push((algo.clone(), *seed, dir, rows, wall));
         }
@@ -180,7 +212,7 @@ pub fn analyse(p: &Protocol, root: &Path, r0: f64) -> Result<Comparison, String>
         summary,
         sample_reduction_vs_reference,
     };
-    plot(p, &curves, threshold, r0, &root.join("learning_curves.png")).map_err(|e| crate::report::chain(&e))?;
+    plot(p, &curves, threshold, r0, &root.join("learning_curves.png"))?;
     Ok(cmp)
 }
 

@@ -42,6 +42,23 @@ impl Default for TrainSettings {
     }
 }
 
+/// A configuration file that cannot be used (always the user's input).
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("{origin}: {source}")]
+    Toml {
+        origin: String,
+        #[source]
+        source: toml::de::Error,
+    },
+    #[error("{origin}: {source}")]
+    Section {
+        origin: String,
+        #[source]
+        source: hgym_agents::learn::LearnError,
+    },
+}
+
 /// The file's tables. Every table but `[train]` and `[env]` is an algorithm's section
 /// (unknown ones are refused by [`TrainConfig::parse`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -71,9 +88,15 @@ impl Default for TrainConfig {
 impl TrainConfig {
     /// Parses a configuration file's text, filling every algorithm's section with its defaults;
     /// an unknown table or field is an error that names it (`origin` names the file).
-    pub fn parse(text: &str, origin: &str) -> Result<Self, String> {
-        let mut c: TrainConfig = toml::from_str(text).map_err(|e| format!("{origin}: {e}"))?;
-        c.algos = c.algos.complete().map_err(|e| format!("{origin}: {e}"))?;
+    pub fn parse(text: &str, origin: &str) -> Result<Self, ConfigError> {
+        let mut c: TrainConfig = toml::from_str(text).map_err(|source| ConfigError::Toml {
+            origin: origin.to_string(),
+            source,
+        })?;
+        c.algos = c.algos.complete().map_err(|source| ConfigError::Section {
+            origin: origin.to_string(),
+            source,
+        })?;
         Ok(c)
     }
 
@@ -90,9 +113,9 @@ mod tests {
     fn defaults_round_trip_and_unknown_fields_are_refused() {
         let c = TrainConfig::default();
         assert_eq!(TrainConfig::parse(&c.to_toml(), "x").unwrap(), c);
-        let e = TrainConfig::parse("[td3]\nbatch = 3\n", "cfg.toml").unwrap_err();
+        let e = TrainConfig::parse("[td3]\nbatch = 3\n", "cfg.toml").unwrap_err().to_string();
         assert!(e.contains("batch"), "{e}");
-        let e = TrainConfig::parse("[tdd3]\nbatch_size = 3\n", "cfg.toml").unwrap_err();
+        let e = TrainConfig::parse("[tdd3]\nbatch_size = 3\n", "cfg.toml").unwrap_err().to_string();
         assert!(e.contains("tdd3"), "{e}");
         let c = TrainConfig::parse("[td3]\nbatch_size = 64\n[train]\nsteps = 10\n", "x").unwrap();
         let td3: hgym_agents::td3::Td3Config = c.algos.section("td3").unwrap();

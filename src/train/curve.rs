@@ -35,19 +35,28 @@ pub fn to_csv(rows: &[CurveRow]) -> String {
 }
 
 /// Reads a curve back (for `hgym plot` and leaderboards); empty cells and "NaN" are NaN.
-pub fn from_csv(text: &str) -> Result<Vec<CurveRow>, String> {
+/// A `curve.csv` that is not an hgym learning curve (the user's input).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct CurveFormatError(pub String);
+
+pub fn from_csv(text: &str) -> Result<Vec<CurveRow>, CurveFormatError> {
     let mut lines = text.lines();
     if lines.next().map(|h| h.trim()) != Some(CSV_HEADER) {
-        return Err("not an hgym learning curve (unexpected header)".into());
+        return Err(CurveFormatError("not an hgym learning curve (unexpected header)".into()));
     }
     let f = |s: &str| s.trim().parse::<f64>().unwrap_or(f64::NAN);
-    let u = |s: &str| s.trim().parse::<u64>().map_err(|_| format!("'{s}' is not a count"));
+    let u = |s: &str| {
+        s.trim()
+            .parse::<u64>()
+            .map_err(|_| CurveFormatError(format!("'{s}' is not a count")))
+    };
     lines
         .filter(|l| !l.trim().is_empty())
         .map(|l| {
             let c: Vec<&str> = l.split(',').collect();
             if c.len() != 9 {
-                return Err(format!("curve row '{l}' has {} columns, expected 9", c.len()));
+                return Err(CurveFormatError(format!("curve row '{l}' has {} columns, expected 9", c.len())));
             }
             Ok(CurveRow {
                 round: u(c[0])?,

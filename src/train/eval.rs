@@ -112,12 +112,26 @@ pub enum NamedPolicy {
     Baseline(Baseline),
 }
 
-pub fn parse_policy(text: &str) -> Result<NamedPolicy, String> {
+/// A `--policy` that names no baseline and no readable policy file.
+#[derive(Debug, thiserror::Error)]
+pub enum PolicyError {
+    /// Always the user's input (exit code 2).
+    #[error("{0}")]
+    Invalid(String),
+    #[error("cannot read {}", path.display())]
+    Read {
+        path: std::path::PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+pub fn parse_policy(text: &str) -> Result<NamedPolicy, PolicyError> {
     let (name, arg) = text.split_once('=').map(|(a, b)| (a, Some(b))).unwrap_or((text, None));
     let num = |s: &str| {
         s.trim()
             .parse::<f64>()
-            .map_err(|_| format!("'{s}' in --policy {text} is not a number"))
+            .map_err(|_| PolicyError::Invalid(format!("'{s}' in --policy {text} is not a number")))
     };
     let b = match (name, arg) {
         ("zero", None) => Baseline::Zero,
@@ -137,14 +151,14 @@ pub fn parse_policy(text: &str) -> Result<NamedPolicy, String> {
         ("pd", Some(spec)) => {
             let parts: Vec<&str> = spec.split(',').collect();
             if parts.len() != 3 {
-                return Err(format!(
+                return Err(PolicyError::Invalid(format!(
                     "--policy {text}: expected pd=SIGNAL,kp,kd (e.g. pd=C_L,1.0,0.5 or pd=obs:3,0.5,0)"
-                ));
+                )));
             }
             let signal = match parts[0].strip_prefix("obs:") {
                 Some(i) => Signal::Obs(
                     i.parse()
-                        .map_err(|_| format!("--policy {text}: '{i}' is not an observation index"))?,
+                        .map_err(|_| PolicyError::Invalid(format!("--policy {text}: '{i}' is not an observation index")))?,
                 ),
                 None => Signal::Info(parts[0].to_string()),
             };
@@ -160,13 +174,17 @@ pub fn parse_policy(text: &str) -> Result<NamedPolicy, String> {
             let dir = Path::new(text);
             let file = if dir.is_dir() { dir.join("policy.json") } else { dir.to_path_buf() };
             if !file.exists() {
-                return Err(format!(
+                return Err(PolicyError::Invalid(format!(
                     "--policy {text}: neither a result folder with policy.json nor a baseline \
                      (zero, random, sine[=period], constant=v, opposition[=gain], pd=SIGNAL,kp,kd)"
-                ));
+                )));
             }
-            let body = std::fs::read_to_string(&file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
-            let p: ActorPolicy = serde_json::from_str(&body).map_err(|e| format!("{} is not a policy file: {e}", file.display()))?;
+            let body = std::fs::read_to_string(&file).map_err(|source| PolicyError::Read {
+                path: file.clone(),
+                source,
+            })?;
+            let p: ActorPolicy =
+                serde_json::from_str(&body).map_err(|e| PolicyError::Invalid(format!("{} is not a policy file: {e}", file.display())))?;
             return Ok(NamedPolicy::Trained(Box::new(p)));
         }
     };

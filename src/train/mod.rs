@@ -34,13 +34,43 @@ use crate::report::manifest::{manifest, Manifest};
 
 #[derive(Debug, thiserror::Error)]
 pub enum TrainError {
-    /// Bad input: an unknown ID, a bad configuration, a damaged checkpoint (exit code 2).
+    /// Bad input: an unknown ID, an algorithm that does not fit the environment (exit code 2).
     #[error("{0}")]
     Input(String),
     #[error(transparent)]
     Env(#[from] EnvError),
-    #[error("{0}")]
-    Io(String),
+    #[error(transparent)]
+    Learn(#[from] hgym_agents::learn::LearnError),
+    #[error(transparent)]
+    Config(#[from] config::ConfigError),
+    #[error(transparent)]
+    Checkpoint(#[from] checkpoint::CheckpointError),
+    #[error("writing the trajectory")]
+    Trajectory(#[from] crate::data::DataError),
+    #[error(transparent)]
+    Report(#[from] crate::report::ReportError),
+    #[error("cannot write {}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+impl TrainError {
+    /// Whether the error is the user's input (exit code 2), not a failure of the run.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            TrainError::Input(_) | TrainError::Config(_) => true,
+            TrainError::Env(e) => matches!(e, EnvError::InvalidSpec(_)),
+            TrainError::Learn(e) => !matches!(
+                e,
+                hgym_agents::learn::LearnError::Env(_) | hgym_agents::learn::LearnError::Encode(_)
+            ),
+            TrainError::Checkpoint(e) => e.is_bad_input(),
+            TrainError::Trajectory(_) | TrainError::Report(_) | TrainError::Io { .. } => false,
+        }
+    }
 }
 
 /// What to train.
@@ -121,9 +151,8 @@ pub fn train(
     let spec = resolve_spec(&opts.env_id, config)?;
     let (obs_dim, act_dim) = (spec.obs_dim(), spec.act_dim());
     let algo = algorithm(&opts.algo).map_err(|e| TrainError::Input(e.to_string()))?;
-    let input = |e: hgym_agents::learn::LearnError| TrainError::Input(e.to_string());
-    let n_envs = algo.n_envs(&config.algos).map_err(input)?;
-    std::fs::create_dir_all(&opts.out).map_err(|e| TrainError::Io(format!("cannot create {}: {e}", opts.out.display())))?;
+    let n_envs = algo.n_envs(&config.algos)?;
+    std::fs::create_dir_all(&opts.out).map_err(io(&opts.out))?;
     let make = || spec.make(opts.level, opts.cache.clone());
     let mut envs: Vec<Box<dyn FlowEnv>> = (0..n_envs).map(|_| make()).collect::<Result<_, _>>()?;
     let mut eval_env = make()?;
@@ -131,11 +160,11 @@ pub fn train(
 
     let (mut learner, mut curve, reference, wall_before, resumed) = match resume {
         Some(ck) => {
-            let learner = algo.decode(&ck.learner).map_err(input)?;
+            let learner = algo.decode(&ck.learner)?;
             (learner, ck.curve, ck.reference, ck.wall_s, ck.resumed + 1)
         }
         None => {
-            let learner = algo.learner(&config.algos, obs_dim, act_dim, opts.seed).map_err(input)?;
+            let learner = algo.learner(&config.algos, obs_dim, act_dim, opts.seed)?;
             let reference = uncontrolled_c_d(&mut eval_env, &periodic_seeds)?;
             (learner, vec![], reference, 0.0, 0)
         }
@@ -151,14 +180,14 @@ pub fn train(
                 seed: opts.seed,
                 level: opts.level,
                 config_toml: config_toml.clone(),
-                learner: learner.to_bytes().map_err(|e| TrainError::Io(e.to_string()))?,
+                learner: learner.to_bytes()?,
                 curve: curve.to_vec(),
                 reference: reference.clone(),
                 wall_s,
                 resumed,
             },
         )
-        .map_err(TrainError::Io)
+        .map_err(TrainError::from)
     };
     let mut last_ckpt = Instant::now();
     let mut last_eval = curve
@@ -237,9 +266,11 @@ pub fn train(
         &opts.out.join("trajectory.mcap"),
         spec.control_interval(),
         spec.trajectory_manifest(opts.level, algo.name(), &final_seeds)
-            .map_err(|e| TrainError::Io(format!("cannot describe the spec: {e}")))?,
-    )
-    .map_err(|e| TrainError::Io(crate::report::chain(&e)))?
+            .map_err(|source| crate::report::ReportError::Json {
+                what: "the spec".into(),
+                source,
+            })?,
+    )?
     .with_fields(config.train.fields_every);
     let report = evaluate(
         &mut eval_env,
@@ -253,14 +284,13 @@ pub fn train(
         Some(&mut trajectory),
         &mut |_| {},
     )?;
-    trajectory.finish().map_err(|e| TrainError::Io(crate::report::chain(&e)))?;
-    let io = |e: std::io::Error| TrainError::Io(format!("writing results to {}: {e}", opts.out.display()));
-    let json = |v: &dyn erased::Json| v.to_json();
-    std::fs::write(opts.out.join("policy.json"), json(&policy) + "\n").map_err(io)?;
-    std::fs::write(opts.out.join("metrics.json"), json(&report) + "\n").map_err(io)?;
-    std::fs::write(opts.out.join("curve.csv"), curve::to_csv(&curve)).map_err(io)?;
+    trajectory.finish()?;
+    write_json(&opts.out.join("policy.json"), "the policy", &policy)?;
+    write_json(&opts.out.join("metrics.json"), "the evaluation", &report)?;
+    let csv = opts.out.join("curve.csv");
+    std::fs::write(&csv, curve::to_csv(&curve)).map_err(io(&csv))?;
     let title = format!("{} {} seed {} ({})", spec.id(), algo.name(), opts.seed, opts.level.name());
-    curve::plot(&opts.out, &title, &curve).map_err(|e| TrainError::Io(crate::report::chain(&e)))?;
+    curve::plot(&opts.out, &title, &curve).map_err(crate::report::ReportError::from)?;
     let m = TrainManifest {
         schema: "hgym/train/v1".into(),
         env_id: spec.id().to_string(),
@@ -276,14 +306,14 @@ pub fn train(
         config_toml,
         manifest: manifest(rayon::current_num_threads(), wall),
     };
-    std::fs::write(opts.out.join("manifest.json"), json(&m) + "\n").map_err(io)?;
+    write_json(&opts.out.join("manifest.json"), "the manifest", &m)?;
     Ok(Ending::Finished(Box::new(report)))
 }
 
 /// Options stored in a checkpoint, for `--resume DIR` (the step budget may be raised).
 pub fn resume_options(dir: &Path, steps: Option<u64>, cache: Option<PathBuf>) -> Result<(TrainOptions, Checkpoint), TrainError> {
-    let ck = checkpoint::load(dir).map_err(TrainError::Input)?;
-    let mut config = TrainConfig::parse(&ck.config_toml, "checkpoint").map_err(TrainError::Input)?;
+    let ck = checkpoint::load(dir)?;
+    let mut config = TrainConfig::parse(&ck.config_toml, "checkpoint")?;
     if let Some(s) = steps {
         config.train.steps = s;
     }
@@ -331,14 +361,19 @@ pub fn summarize(env_id: &str, algo: &str, level: &str, runs: &[(u64, PathBuf, E
     }
 }
 
-mod erased {
-    /// Pretty JSON of any serialisable value (NaN becomes null).
-    pub trait Json {
-        fn to_json(&self) -> String;
+/// An I/O error on `path`.
+fn io(path: &Path) -> impl Fn(std::io::Error) -> TrainError + '_ {
+    move |source| TrainError::Io {
+        path: path.to_path_buf(),
+        source,
     }
-    impl<T: serde::Serialize> Json for T {
-        fn to_json(&self) -> String {
-            serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
-        }
-    }
+}
+
+/// `value` as pretty JSON in `path` (NaN becomes null); `what` names it in an error.
+fn write_json<T: Serialize>(path: &Path, what: &str, value: &T) -> Result<(), TrainError> {
+    let text = serde_json::to_string_pretty(value).map_err(|source| crate::report::ReportError::Json {
+        what: what.to_string(),
+        source,
+    })?;
+    std::fs::write(path, text + "\n").map_err(io(path))
 }

@@ -101,7 +101,7 @@ fn write_outputs(report: &ValidationReport, output: &run::RunOutput, out: &Path)
     std::fs::create_dir_all(&dir).map_err(|e| out_err(&dir)(e.to_string()))?;
     report::write_plots(report, output, &dir).map_err(|e| out_err(&dir)(crate::report::chain(&e)))?;
     let csv = dir.join("forces.csv");
-    series::write_forces_csv(output, &csv).map_err(out_err(&csv))?;
+    series::write_forces_csv(output, &csv).map_err(|e| out_err(&csv)(e.to_string()))?;
     let json_path = out.join(format!("{}.json", report.case));
     let text = serde_json::to_string_pretty(report).map_err(|e| out_err(&json_path)(e.to_string()))?;
     std::fs::write(&json_path, text + "\n").map_err(|e| out_err(&json_path)(e.to_string()))?;

@@ -25,8 +25,8 @@ pub fn stride(t0: f64) -> usize {
 }
 
 /// Writes the history (up to a divergence, if the run diverged) to `path`.
-pub fn write_forces_csv(out: &RunOutput, path: &Path) -> Result<(), String> {
-    let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
+pub fn write_forces_csv(out: &RunOutput, path: &Path) -> std::io::Result<()> {
+    let file = std::fs::File::create(path)?;
     let mut w = std::io::BufWriter::new(file);
     let per_body = out.cd_bodies.len() > 1;
     let mut header = String::from("t,c_d,c_l");
@@ -35,7 +35,7 @@ pub fn write_forces_csv(out: &RunOutput, path: &Path) -> Result<(), String> {
             header += &format!(",c_d_{b},c_l_{b}");
         }
     }
-    writeln!(w, "{header}").map_err(|e| e.to_string())?;
+    writeln!(w, "{header}")?;
     let step = stride(out.t.first().copied().unwrap_or(0.0));
     // Sample i is step i + 1: keep the steps that are multiples of the stride.
     for i in (step - 1..out.t.len()).step_by(step) {
@@ -45,9 +45,9 @@ pub fn write_forces_csv(out: &RunOutput, path: &Path) -> Result<(), String> {
                 line += &format!(",{:.7e},{:.7e}", cd[i], cl[i]);
             }
         }
-        writeln!(w, "{line}").map_err(|e| e.to_string())?;
+        writeln!(w, "{line}")?;
     }
-    w.flush().map_err(|e| e.to_string())
+    w.flush()
 }
 
 #[cfg(test)]
