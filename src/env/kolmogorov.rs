@@ -218,9 +218,7 @@ impl FamilySpec for KolmogorovSpec {
             return Err(CalibrateError::NoActions);
         }
         let table = table.map_or_else(|| PathBuf::from(TABLE_PATH), Path::to_path_buf);
-        if let Ok(text) = std::fs::read_to_string(&table) {
-            crate::report::table::parse::<FlowStatistics>(&text, &table)?;
-        }
+        crate::report::table::check::<FlowStatistics>(&table)?;
         let st = calibrate(self, level, actions, progress)?;
         let summary = format!(
             "{}: u_rms {:.4}, dissipation {:.4} +- {:.4} (laminar {:.4}), TKE {:.4} over {} time units",

@@ -705,10 +705,7 @@ impl FamilySpec for EnvSpec {
             return Err(CalibrateError::NoActions);
         }
         let table = table.map_or_else(|| PathBuf::from(super::calibrate::TABLE_PATH), Path::to_path_buf);
-        // Fail before the run on a table that cannot be read back.
-        if let Ok(text) = std::fs::read_to_string(&table) {
-            crate::report::table::parse::<super::calibrate::Entry>(&text, &table)?;
-        }
+        crate::report::table::check::<super::calibrate::Entry>(&table)?;
         let entry = super::calibrate::calibrate(self, level, actions, cache, &mut |k, _| progress(k))?;
         let summary = match entry.mean_forces {
             Some([c_d, c_l]) => format!("{}: uncontrolled mean C_D {c_d:.4}, mean C_L {c_l:.4}", self.id),

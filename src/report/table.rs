@@ -30,6 +30,19 @@ pub fn parse<T: DeserializeOwned>(text: &str, path: &Path) -> Result<BTreeMap<St
     })
 }
 
+/// Fails when the table at `path` exists but cannot be read back as rows of `T` (checked before
+/// a long run that will record into it).
+pub fn check<T: DeserializeOwned>(path: &Path) -> Result<(), TableError> {
+    match std::fs::read_to_string(path) {
+        Ok(text) => parse::<T>(&text, path).map(|_| ()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(source) => Err(TableError::Io {
+            path: path.to_path_buf(),
+            source,
+        }),
+    }
+}
+
 /// Inserts `rows` into the table at `path` (created when missing), replacing rows of the same key.
 pub fn record<T: Serialize + DeserializeOwned + Clone>(path: &Path, rows: &[(String, T)]) -> Result<(), TableError> {
     let io = |source| TableError::Io {

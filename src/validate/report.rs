@@ -608,15 +608,19 @@ mod tests {
         c.case.reference.retain(|x| x.quantity != crate::validate::case::Quantity::ClRms);
         let out = synthetic_output(&shedding);
         assert_eq!(ValidationReport::from_run(&c, &out, 1).status, Status::Pass);
-        let cd = c
-            .case
-            .reference
-            .iter_mut()
-            .find(|x| x.quantity == crate::validate::case::Quantity::MeanCd)
-            .unwrap();
-        cd.value = 2.0; // the synthetic run's mean C_D is 1.46: 27 % off
-        cd.judged = Some(false);
-        cd.reason = Some("no independent value".into());
+        // The mean C_D reference of the case: judged (None) or not (Some(false)), with a reason or not.
+        let set_cd = |c: &mut LoadedCase, judged: Option<bool>, reason: Option<&str>| {
+            let cd = c
+                .case
+                .reference
+                .iter_mut()
+                .find(|x| x.quantity == crate::validate::case::Quantity::MeanCd)
+                .unwrap();
+            cd.value = 2.0; // the synthetic run's mean C_D is 1.46: 27 % off
+            cd.judged = judged;
+            cd.reason = reason.map(String::from);
+        };
+        set_cd(&mut c, Some(false), Some("no independent value"));
         c.check_static().unwrap();
         let r = ValidationReport::from_run(&c, &out, 1);
         assert_eq!(r.status, Status::Pass, "{}", r.table());
@@ -625,25 +629,9 @@ mod tests {
             table.contains("outside (unconfirmed ref.)") && table.contains("no independent value"),
             "{table}"
         );
-        let judged = |c: &mut LoadedCase| {
-            let cd = c
-                .case
-                .reference
-                .iter_mut()
-                .find(|x| x.quantity == crate::validate::case::Quantity::MeanCd)
-                .unwrap();
-            cd.judged = None;
-            cd.reason = None;
-        };
-        judged(&mut c);
+        set_cd(&mut c, None, None);
         assert_eq!(ValidationReport::from_run(&c, &out, 1).status, Status::Fail);
-        let cd = c
-            .case
-            .reference
-            .iter_mut()
-            .find(|x| x.quantity == crate::validate::case::Quantity::MeanCd)
-            .unwrap();
-        cd.judged = Some(false);
+        set_cd(&mut c, Some(false), None);
         let e = c.check_static().unwrap_err();
         assert!(e.to_string().contains("reason"), "{e}");
     }
