@@ -128,6 +128,9 @@ impl Peer {
                 message: e.to_string(),
             });
         }
+        // The peer's idle OpenMP workers (torch's) spin for a while after its turn: let them
+        // settle before ours is timed (a passive wait policy instead slows the peer itself).
+        std::thread::sleep(std::time::Duration::from_millis(500));
         Ok(v)
     }
 
