@@ -30,25 +30,24 @@ setup: $(VENV)/.installed
 	@command -v $(CARGO) >/dev/null || { echo "cargo not found: install Rust from https://rustup.rs"; exit 2; }
 	@command -v cc >/dev/null || { echo "a C compiler (gcc) is needed for some crates"; exit 2; }
 
-$(VENV)/.installed: Makefile
+$(VENV)/.installed: scripts/requirements-test.txt
 	@command -v $(PYTHON) >/dev/null || { echo "python3 not found (Python 3.11 is assumed)"; exit 2; }
 	$(PYTHON) -m venv $(VENV)
-	$(VENV)/bin/pip install --quiet --disable-pip-version-check "mcap>=1.2,<2" "pandas>=2" "pyarrow>=15" "datasets>=2.19" pyyaml
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r $<
 	@touch $@
 
 # The peers `hgym bench agents --peer` and `hgym bench kolmogorov --peer` time beside ours, in a
 # venv of their own: hydrogym 1.0.0 pins huggingface-hub 0.16 and pandas 2.3, which break the
-# `datasets` the tests read exports with. PyPI's torch wheel brings its CUDA libraries (about
-# 6 GB); it runs on the CPU here. The gymnax 1.0.1 incompatibility of hydrogym 1.0.0 is adapted
+# `datasets` the tests read exports with. The gymnax 1.0.1 incompatibility of hydrogym 1.0.0 is adapted
 # in scripts/peers/hydrogym_kolmogorov.py, not patched into the installed files.
 PEERS_VENV ?= $(HOME)/.cache/hgym-peers
 
 peers: $(PEERS_VENV)/.installed
 
-$(PEERS_VENV)/.installed: Makefile
+$(PEERS_VENV)/.installed: scripts/peers/requirements.txt
 	@command -v $(PYTHON) >/dev/null || { echo "python3 not found (Python 3.11 is assumed)"; exit 2; }
 	$(PYTHON) -m venv $(PEERS_VENV)
-	$(PEERS_VENV)/bin/pip install --quiet --disable-pip-version-check "stable-baselines3==2.9.2" "hydrogym[jax]==1.0.0" "gymnax==1.0.1"
+	$(PEERS_VENV)/bin/pip install --quiet --disable-pip-version-check -r $<
 	$(PEERS_VENV)/bin/python -c "import stable_baselines3, torch, hydrogym.jax.envs.kolmogorov"
 	@touch $@
 

@@ -560,6 +560,16 @@ fn a_closed_stdout_pipe_exits_0_without_a_panic() {
 }
 
 #[test]
+fn calibrating_over_no_actions_exits_2_for_every_family() {
+    for id in ["Cylinder_2D_Re100", "Kolmogorov_2D_Re40"] {
+        let o = hgym(&["envs", "calibrate", id, "--actions", "0", "--table", "/nonexistent/table.json"]);
+        let (_, err) = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{id}: {err}");
+        assert!(err.contains("--actions must be at least 1"), "{id}: {err}");
+    }
+}
+
+#[test]
 fn unknown_env_id_exits_2_with_suggestions() {
     for args in [
         vec!["envs", "show", "Cylinder_2D_Re10"],

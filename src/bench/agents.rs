@@ -76,7 +76,7 @@ pub fn bench_agents(quick: bool, mut peer: Option<&mut Peer>) -> Result<AgentsBe
         let mut v = vec![];
         for _ in 0..pair_count {
             let ours = 1.0 / time_td3();
-            v.push((ours, p.number(&format!("td3 {n}"), "updates_per_s")?));
+            v.push((ours, p.numbers(&format!("td3 {n}"), ["updates_per_s"])?[0]));
         }
         pairs.push(Pairs::new("TD3 256x256 batch 256", "updates/s", &v, true));
     }
@@ -136,7 +136,7 @@ pub fn bench_agents(quick: bool, mut peer: Option<&mut Peer>) -> Result<AgentsBe
         let mut v = vec![];
         for _ in 0..pair_count {
             let ours = time_td3_policy();
-            v.push((ours, p.number(&format!("policy {}", reps / 10), "us")?));
+            v.push((ours, p.numbers(&format!("policy {}", reps / 10), ["us"])?[0]));
         }
         pairs.push(Pairs::new("policy 256x256, batch 1", "us", &v, false));
     }

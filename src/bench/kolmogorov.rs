@@ -193,27 +193,20 @@ fn with_peer(p: &mut Peer, quick: bool, w0: &[C], our_dt: f64) -> Result<Kolmogo
     for _ in 0..if quick { 1 } else { 3 } {
         let (_, at_1e3) = run_to(64, 1e-3, w0, 10.0);
         let (_, at_ours) = run_to(64, our_dt, w0, 10.0);
-        let v = p.ask("action")?;
-        let number = |key: &str| {
-            v.get(key).and_then(|x| x.as_f64()).ok_or_else(|| PeerError::Failed {
-                script: "hydrogym_kolmogorov.py".into(),
-                message: format!("answer to 'action' has no number '{key}': {v}"),
-            })
-        };
-        rates.push((10.0 / 1e-3 / at_1e3, number("steps_per_s")?));
-        actions.push((at_ours, number("s_per_action")?));
+        let [steps_per_s, s_per_action] = p.numbers("action", ["steps_per_s", "s_per_action"])?;
+        rates.push((10.0 / 1e-3 / at_1e3, steps_per_s));
+        actions.push((at_ours, s_per_action));
     }
-    let acc = p.ask("accuracy")?;
-    let get = |key: &str| acc.get(key).and_then(|x| x.as_f64()).unwrap_or(f64::NAN);
+    let [dt, reference_dt, relative_error] = p.numbers("accuracy", ["dt", "reference_dt", "relative_error"])?;
     Ok(KolmogorovPeer {
         about: p.about.clone(),
         pairs: vec![
             Pairs::new("steps/s, N 64, dt 1e-3", "steps/s", &rates, true),
             Pairs::new("s per action, own dt", "s", &actions, false),
         ],
-        dt: get("dt"),
-        reference_dt: get("reference_dt"),
-        relative_error: get("relative_error"),
+        dt,
+        reference_dt,
+        relative_error,
     })
 }
 

@@ -134,13 +134,17 @@ impl Peer {
         Ok(v)
     }
 
-    /// A number from an answer.
-    pub fn number(&mut self, command: &str, key: &str) -> Result<f64, PeerError> {
+    /// The numbers `keys` of the answer to `command`; a missing or non-numeric one is an error.
+    pub fn numbers<const K: usize>(&mut self, command: &str, keys: [&str; K]) -> Result<[f64; K], PeerError> {
         let v = self.ask(command)?;
-        v.get(key).and_then(|x| x.as_f64()).ok_or_else(|| PeerError::Failed {
-            script: self.script.clone(),
-            message: format!("answer to '{command}' has no number '{key}': {v}"),
-        })
+        let mut out = [0.0; K];
+        for (o, key) in out.iter_mut().zip(keys) {
+            *o = v.get(key).and_then(|x| x.as_f64()).ok_or_else(|| PeerError::Failed {
+                script: self.script.clone(),
+                message: format!("answer to '{command}' has no number '{key}': {v}"),
+            })?;
+        }
+        Ok(out)
     }
 }
 

@@ -52,34 +52,12 @@ pub enum BenchCommand {
     /// latency. With --peer, Stable-Baselines3's TD3 at the same shapes is timed in the same run,
     /// alternating with ours, and the ratios printed; without it, no ratio. Exit 1 if a policy
     /// evaluation takes 10 us or more; 2 if --peer is given and the peers are not installed.
-    Agents {
-        #[arg(long)]
-        json: bool,
-        /// Short timings (targets not judged).
-        #[arg(long)]
-        quick: bool,
-        #[arg(long)]
-        threads: Option<usize>,
-        /// Time Stable-Baselines3 beside ours (`make peers` installs it).
-        #[arg(long)]
-        peer: bool,
-    },
+    Agents(#[command(flatten)] PeerBenchArgs),
     /// Spectral Kolmogorov solver: steps/s at N 64-256, VJP cost, accuracy against step size.
     /// With --peer, HydroGym's JAX Kolmogorov env (N 64, Re 40, float64) is timed in the same run,
     /// alternating with ours, with each one's step size and accuracy per control action. Exit 1 if
     /// a VJP costs more than 3 steps; 2 if --peer is given and the peers are not installed.
-    Kolmogorov {
-        #[arg(long)]
-        json: bool,
-        /// Short timings and a 1-time-unit action (targets not judged).
-        #[arg(long)]
-        quick: bool,
-        #[arg(long)]
-        threads: Option<usize>,
-        /// Time HydroGym's JAX env beside ours (`make peers` installs it).
-        #[arg(long)]
-        peer: bool,
-    },
+    Kolmogorov(#[command(flatten)] PeerBenchArgs),
     /// Control steps (actions) per second of each environment family at coarse and default.
     Envs {
         /// Print the rows as JSON.
@@ -95,6 +73,22 @@ pub enum BenchCommand {
         #[arg(long)]
         family: Vec<String>,
     },
+}
+
+/// The options of a benchmark that can time a peer beside ours.
+#[derive(clap::Args)]
+pub struct PeerBenchArgs {
+    /// Print the report as JSON.
+    #[arg(long)]
+    json: bool,
+    /// Short timings (targets not judged).
+    #[arg(long)]
+    quick: bool,
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Time the peer beside ours in the same run, alternating (`make peers` installs it).
+    #[arg(long)]
+    peer: bool,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -131,18 +125,13 @@ pub fn run(cmd: BenchCommand) -> Result<Outcome> {
             quick,
             family,
         } => run_bench_envs(json, actions, quick, &family),
-        BenchCommand::Agents {
+        BenchCommand::Agents(args) => run_bench_agents(args),
+        BenchCommand::Kolmogorov(PeerBenchArgs {
             json,
             quick,
             threads,
             peer,
-        } => run_bench_agents(json, quick, threads, peer),
-        BenchCommand::Kolmogorov {
-            json,
-            quick,
-            threads,
-            peer,
-        } => {
+        }) => {
             let (pool, n) = thread_pool(threads)?;
             let mut peer = start_peer(peer, hgym::bench::peer::HYDROGYM_KOLMOGOROV, n)?;
             let b = pool.install(|| hgym::bench::kolmogorov::bench_kolmogorov(quick, peer.as_mut()))?;
@@ -246,7 +235,14 @@ fn start_peer(wanted: bool, script: (&str, &str), threads: usize) -> Result<Opti
     }
 }
 
-fn run_bench_agents(json: bool, quick: bool, threads: Option<usize>, peer: bool) -> Result<Outcome> {
+fn run_bench_agents(
+    PeerBenchArgs {
+        json,
+        quick,
+        threads,
+        peer,
+    }: PeerBenchArgs,
+) -> Result<Outcome> {
     let (pool, n) = thread_pool(threads)?;
     let mut peer = start_peer(peer, hgym::bench::peer::SB3_TD3, n)?;
     let b = pool.install(|| hgym::bench::agents::bench_agents(quick, peer.as_mut()))?;

@@ -115,9 +115,6 @@ pub fn run(args: EnvsArgs) -> Result<Outcome> {
             threads,
         }) => {
             let spec = hgym::env::lookup(&id)?;
-            if actions == 0 {
-                return Err(UsageError("--actions must be at least 1".into()).into());
-            }
             let (pool, _) = thread_pool(threads)?;
             let pb = Progress::new(actions as u64, &id);
             let result = pool.install(|| {
