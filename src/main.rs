@@ -154,6 +154,7 @@ fn is_bad_input(e: &anyhow::Error) -> bool {
                 .is_some_and(|t| t.is_bad_input())
             || matches!(c.downcast_ref::<hgym::data::DataError>(), Some(hgym::data::DataError::Format(_)))
             || matches!(c.downcast_ref::<EnvError>(), Some(EnvError::InvalidSpec(_)))
+            || c.downcast_ref::<hgym::data::hub::HubError>().is_some_and(|h| h.is_bad_input())
             || matches!(
                 c.downcast_ref::<hgym::env::family::CalibrateError>(),
                 Some(hgym::env::family::CalibrateError::NoActions)

@@ -162,3 +162,40 @@ fn export_loads_with_datasets_and_pandas_and_matches_the_mcap_files() {
     let o = hgym(&["export", "--to", "hf", tmp.path().join("nothing").to_str().unwrap(), "x"]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+/// A trajectory whose manifest's env_id would name a folder outside the output (`../../x`, an
+/// absolute path) or none at all: export refuses it with exit 2, naming the file, and writes
+/// nothing anywhere.
+#[test]
+fn export_refuses_env_ids_that_are_not_ids() {
+    use hgym_agents::Info;
+    let tmp = tempfile::tempdir().unwrap();
+    let escape = tmp.path().join("escape");
+    let hostile = [
+        Some("../../escape/x".to_string()),
+        Some(escape.join("abs").display().to_string()),
+        Some("Cylinder_2D_Re100/../../../escape".to_string()),
+        None,
+    ];
+    for (k, env_id) in hostile.iter().enumerate() {
+        let runs = tmp.path().join(format!("runs{k}"));
+        std::fs::create_dir_all(runs.join("r")).unwrap();
+        let mut manifest = std::collections::BTreeMap::new();
+        if let Some(id) = env_id {
+            manifest.insert("env_id".to_string(), id.clone());
+        }
+        let mut w = hgym::data::trajectory::TrajectoryWriter::create(&runs.join("r/trajectory.mcap"), 1.0, manifest).unwrap();
+        w.reset(&[0.0], &Info::default()).unwrap();
+        w.finish().unwrap();
+        let out = tmp.path().join(format!("deep/a/b/out{k}"));
+        let o = hgym(&["export", "--to", "hf", runs.to_str().unwrap(), out.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{env_id:?}: {err}");
+        assert!(err.contains("trajectory.mcap") && err.contains("env_id"), "{env_id:?}: {err}");
+        assert!(
+            !tmp.path().join("deep").exists(),
+            "{env_id:?}: nothing written, in or beside the output"
+        );
+        assert!(!escape.exists(), "{env_id:?}: nothing at the absolute path");
+    }
+}

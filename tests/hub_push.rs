@@ -1,6 +1,10 @@
 //! `hgym push` against a local stand-in for the Hugging Face Hub on 127.0.0.1: it implements the
 //! endpoints hgym calls (repo create, preupload, LFS batch + upload + verify, commit), checks
-//! the token on every Hub call, and injects 429 / 503 / 500 answers to exercise retries.
+//! the token on every Hub call, and injects 429 / 503 / 500 answers to exercise retries. It also
+//! misbehaves on purpose ([`Misbehave`]): verify addresses and redirects on another origin (a
+//! second server that records what reaches it), malformed and empty answers, `Retry-After`
+//! garbage, errors that echo the token, and silence. The token must never reach another origin,
+//! nor appear in output or files.
 
 use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Read, Write};
@@ -22,14 +26,38 @@ struct Request {
     body: Vec<u8>,
 }
 
+/// How the stand-in departs from the Hub's protocol.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+enum Misbehave {
+    #[default]
+    None,
+    /// Every commit answers 500 (the retry limit).
+    CommitFails,
+    /// The LFS verify address is on another port whose address text starts with the endpoint's.
+    ForeignVerify,
+    /// Repository creation answers 307 to another origin.
+    RedirectAway,
+    /// The commit answers 200 with text that is not JSON.
+    CommitNotJson,
+    /// The commit answers 200 with an empty body.
+    CommitEmpty,
+    /// The first creation answers 429 with `Retry-After: NaN`.
+    RetryAfterNaN,
+    /// The commit answers 500 with the request's Authorization header in its body.
+    EchoToken,
+    /// The preupload answer lacks the files' upload modes.
+    NoModes,
+}
+
 #[derive(Default)]
 struct Hub {
     requests: Vec<Request>,
     lfs: HashMap<String, Vec<u8>>,
     commits: Vec<String>,
     created: Vec<serde_json::Value>,
-    /// Answer every commit with 500 (the retry limit test).
-    commit_always_fails: bool,
+    misbehave: Misbehave,
+    /// The other origin's address (`http://127.0.0.1:OTHER`).
+    foreign: String,
     put_failed_once: bool,
 }
 
@@ -86,8 +114,15 @@ fn handle(mut s: TcpStream, hub: &Arc<Mutex<Hub>>, port: u16) {
         return respond(&mut s, 401, "", r#"{"error":"Invalid credentials in Authorization header"}"#);
     }
     let creates = h.requests.iter().filter(|r| r.path == "/api/repos/create").count();
+    let m = h.misbehave;
     match (req.method.as_str(), req.path.as_str()) {
-        ("POST", "/api/repos/create") if creates == 1 => respond(&mut s, 429, "Retry-After: 0\r\n", r#"{"error":"slow down"}"#),
+        ("POST", "/api/repos/create") if m == Misbehave::RedirectAway => {
+            respond(&mut s, 307, &format!("Location: {}/api/repos/create\r\n", h.foreign), "")
+        }
+        ("POST", "/api/repos/create") if creates == 1 => {
+            let after = if m == Misbehave::RetryAfterNaN { "NaN" } else { "0" };
+            respond(&mut s, 429, &format!("Retry-After: {after}\r\n"), r#"{"error":"slow down"}"#)
+        }
         ("POST", "/api/repos/create") => {
             h.created.push(json(&req.body));
             respond(&mut s, 200, "", r#"{"url":"http://hub/datasets/alice/flows"}"#)
@@ -99,7 +134,11 @@ fn handle(mut s: TcpStream, hub: &Arc<Mutex<Hub>>, port: u16) {
                 .iter()
                 .map(|f| {
                     let p = f["path"].as_str().unwrap();
-                    let mode = if p.ends_with(".parquet") { "lfs" } else { "regular" };
+                    let mode = match (m, p.ends_with(".parquet")) {
+                        (Misbehave::NoModes, _) => "unknown",
+                        (_, true) => "lfs",
+                        (_, false) => "regular",
+                    };
                     serde_json::json!({"path": p, "uploadMode": mode, "shouldIgnore": false})
                 })
                 .collect();
@@ -112,9 +151,13 @@ fn handle(mut s: TcpStream, hub: &Arc<Mutex<Hub>>, port: u16) {
                 .iter()
                 .map(|o| {
                     let oid = o["oid"].as_str().unwrap();
+                    let verify = match m {
+                        Misbehave::ForeignVerify => format!("{}/lfs/verify", h.foreign),
+                        _ => format!("http://127.0.0.1:{port}/lfs/verify"),
+                    };
                     serde_json::json!({"oid": oid, "size": o["size"], "actions": {
                         "upload": {"href": format!("http://127.0.0.1:{port}/lfs/upload/{oid}"), "header": {"X-Test": "1"}},
-                        "verify": {"href": format!("http://127.0.0.1:{port}/lfs/verify"), "header": {}}}})
+                        "verify": {"href": verify, "header": {}}}})
                 })
                 .collect();
             respond(&mut s, 200, "", &serde_json::json!({ "objects": objects }).to_string())
@@ -131,8 +174,15 @@ fn handle(mut s: TcpStream, hub: &Arc<Mutex<Hub>>, port: u16) {
         }
         ("POST", "/lfs/verify") => respond(&mut s, 200, "", "{}"),
         ("POST", "/api/datasets/alice/flows/commit/main") => {
-            if h.commit_always_fails {
-                return respond(&mut s, 500, "", r#"{"error":"internal"}"#);
+            match m {
+                Misbehave::CommitFails => return respond(&mut s, 500, "", r#"{"error":"internal"}"#),
+                Misbehave::CommitNotJson => return respond(&mut s, 200, "", "<html>gateway</html>"),
+                Misbehave::CommitEmpty => return respond(&mut s, 200, "", ""),
+                Misbehave::EchoToken => {
+                    let echo = format!("bad header {}", req.auth.clone().unwrap_or_default());
+                    return respond(&mut s, 500, "", &serde_json::json!({ "error": echo }).to_string());
+                }
+                _ => {}
             }
             h.commits.push(String::from_utf8(req.body.clone()).unwrap());
             respond(&mut s, 200, "", r#"{"commitOid":"c0ffee","commitUrl":"http://hub/c0ffee"}"#)
@@ -141,12 +191,65 @@ fn handle(mut s: TcpStream, hub: &Arc<Mutex<Hub>>, port: u16) {
     }
 }
 
-/// Starts the stand-in Hub; returns its endpoint and state.
-fn serve(commit_always_fails: bool) -> (String, Arc<Mutex<Hub>>) {
+/// Another origin on 127.0.0.1 (`listener`): records every request and answers 200 `{}`.
+fn serve_foreign(listener: TcpListener) -> (String, Arc<Mutex<Vec<Request>>>) {
+    let port = listener.local_addr().unwrap().port();
+    let seen = Arc::new(Mutex::new(vec![]));
+    let s2 = seen.clone();
+    std::thread::spawn(move || {
+        for mut s in listener.incoming().flatten() {
+            if let Some(r) = read_request(&mut s) {
+                s2.lock().unwrap().push(r);
+            }
+            respond(&mut s, 200, "", "{}");
+        }
+    });
+    (format!("http://127.0.0.1:{port}"), seen)
+}
+
+/// The stand-in Hub and another origin whose address starts with the Hub's text
+/// (`http://127.0.0.1:4123` and `http://127.0.0.1:41234`), which a prefix check takes for the Hub.
+#[allow(clippy::type_complexity)]
+fn serve_pair(misbehave: Misbehave) -> (String, Arc<Mutex<Hub>>, String, Arc<Mutex<Vec<Request>>>) {
+    for _ in 0..100 {
+        let foreign = TcpListener::bind("127.0.0.1:0").unwrap();
+        let p = foreign.local_addr().unwrap().port();
+        if p < 10000 {
+            continue;
+        }
+        if let Ok(hub) = TcpListener::bind(("127.0.0.1", p / 10)) {
+            let (foreign, seen) = serve_foreign(foreign);
+            let (endpoint, state) = serve_on(hub, misbehave, &foreign);
+            assert!(foreign.starts_with(&endpoint));
+            return (endpoint, state, foreign, seen);
+        }
+    }
+    panic!("no free pair of ports P and P/10 on 127.0.0.1")
+}
+
+/// A server that accepts connections and never answers.
+fn serve_silent() -> String {
     let listener = TcpListener::bind("127.0.0.1:0").unwrap();
     let port = listener.local_addr().unwrap().port();
+    std::thread::spawn(move || {
+        let mut held = vec![];
+        for s in listener.incoming().flatten() {
+            held.push(s);
+        }
+    });
+    format!("http://127.0.0.1:{port}")
+}
+
+/// Starts the stand-in Hub; returns its endpoint and state.
+fn serve(misbehave: Misbehave, foreign: &str) -> (String, Arc<Mutex<Hub>>) {
+    serve_on(TcpListener::bind("127.0.0.1:0").unwrap(), misbehave, foreign)
+}
+
+fn serve_on(listener: TcpListener, misbehave: Misbehave, foreign: &str) -> (String, Arc<Mutex<Hub>>) {
+    let port = listener.local_addr().unwrap().port();
     let hub = Arc::new(Mutex::new(Hub {
-        commit_always_fails,
+        misbehave,
+        foreign: foreign.to_string(),
         ..Hub::default()
     }));
     let h = hub.clone();
@@ -211,7 +314,7 @@ fn push_uploads_through_lfs_and_commits_with_retries_and_auth_errors() {
     std::fs::create_dir_all(&hf_home).unwrap();
 
     // No token anywhere: a clear error before any request.
-    let (endpoint, hub) = serve(false);
+    let (endpoint, hub) = serve(Misbehave::None, "");
     let o = push(&ds, &endpoint, None, &hf_home, &[]);
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("no Hugging Face token"), "{}", text(&o));
@@ -287,7 +390,7 @@ fn push_uploads_through_lfs_and_commits_with_retries_and_auth_errors() {
     drop(h);
 
     // A server that keeps failing: the retries are bounded and the error says where it failed.
-    let (endpoint, hub) = serve(true);
+    let (endpoint, hub) = serve(Misbehave::CommitFails, "");
     let o = push(&ds, &endpoint, Some(TOKEN), &hf_home, &["--retries", "2"]);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     assert!(text(&o).contains("answered 500 while committing"), "{}", text(&o));
@@ -308,4 +411,98 @@ fn push_uploads_through_lfs_and_commits_with_retries_and_auth_errors() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o).contains("user/name"), "{}", text(&o));
+}
+
+/// Every file under `dir`, read.
+fn all_bytes(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut out = vec![];
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            if e.path().is_dir() {
+                stack.push(e.path())
+            } else {
+                out.push((e.path(), std::fs::read(e.path()).unwrap()));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn a_misbehaving_hub_gets_clear_errors_and_never_the_token() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ds = dataset(tmp.path());
+    let hf_home = tmp.path().join("hf_home");
+    std::fs::create_dir_all(&hf_home).unwrap();
+    let secret = TOKEN.as_bytes();
+    let no_token_in = |o: &Output, case: &str| {
+        assert!(!text(o).contains(TOKEN), "{case}: the token appears in the output: {}", text(o));
+        assert!(!text(o).contains("SECRET_4711"), "{case}: part of the token appears: {}", text(o));
+    };
+
+    // (case, expected exit code, words the message must contain)
+    let cases = [
+        (Misbehave::ForeignVerify, None, ""),
+        (Misbehave::RedirectAway, Some(1), "redirected to"),
+        (Misbehave::CommitNotJson, Some(1), "not what its API returns"),
+        (Misbehave::CommitEmpty, Some(1), "(empty)"),
+        (Misbehave::RetryAfterNaN, Some(0), ""),
+        (Misbehave::EchoToken, Some(1), "answered 500 while committing"),
+        (Misbehave::NoModes, Some(1), "no upload mode"),
+    ];
+    for (m, code, words) in cases {
+        let (endpoint, hub, _, seen) = serve_pair(m);
+        let o = push(&ds, &endpoint, Some(TOKEN), &hf_home, &["--retries", "1"]);
+        let case = format!("{m:?}");
+        if let Some(code) = code {
+            assert_eq!(o.status.code(), Some(code), "{case}: {}", text(&o));
+        }
+        assert!(text(&o).contains(words), "{case}: {}", text(&o));
+        assert!(!text(&o).contains("panicked"), "{case}: {}", text(&o));
+        no_token_in(&o, &case);
+        for r in seen.lock().unwrap().iter() {
+            assert!(
+                r.auth.as_deref().is_none_or(|a| !a.contains(TOKEN)),
+                "{case}: the token reached the other origin: {r:?}"
+            );
+        }
+        let h = hub.lock().unwrap();
+        match m {
+            Misbehave::ForeignVerify => assert!(
+                seen.lock().unwrap().iter().any(|r| r.path == "/lfs/verify"),
+                "the foreign verify address is called, without the token"
+            ),
+            Misbehave::RedirectAway => {
+                assert!(seen.lock().unwrap().is_empty(), "a redirect to another origin is not followed");
+                assert!(h.commits.is_empty());
+            }
+            Misbehave::RetryAfterNaN => assert_eq!(h.commits.len(), 1, "retried with the backoff, then committed"),
+            Misbehave::NoModes => assert!(h.commits.is_empty(), "nothing committed on an answer without modes"),
+            _ => {}
+        }
+    }
+
+    // Silence: a server that never answers has timed out after --timeout, retries included.
+    let endpoint = serve_silent();
+    let t0 = std::time::Instant::now();
+    let o = push(&ds, &endpoint, Some(TOKEN), &hf_home, &["--retries", "1", "--timeout", "1"]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert!(text(&o).contains("timed out") && text(&o).contains("2 attempt(s)"), "{}", text(&o));
+    assert!(t0.elapsed().as_secs() < 20, "bounded by the timeout: {:?}", t0.elapsed());
+    no_token_in(&o, "silent");
+
+    // Plain http to a host that is not this machine: refused before any request, exit 2.
+    let o = push(&ds, "http://hub.example.invalid", Some(TOKEN), &hf_home, &[]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("plain http"), "{}", text(&o));
+
+    // The token is in no file the pushes left behind.
+    for (path, bytes) in all_bytes(tmp.path()) {
+        assert!(
+            !bytes.windows(secret.len()).any(|w| w == secret),
+            "the token is in {}",
+            path.display()
+        );
+    }
 }

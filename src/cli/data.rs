@@ -2,11 +2,12 @@
 //! folder to the Hub.
 
 use std::path::PathBuf;
+use std::time::Duration;
 
 use anyhow::Result;
 use clap::{Args, Subcommand, ValueEnum};
 use hgym::data::hf::{export, ExportOptions};
-use hgym::data::hub::{self, HubConfig, HubError};
+use hgym::data::hub::{self, HubConfig};
 
 use crate::{Outcome, UsageError};
 
@@ -93,32 +94,28 @@ pub struct PushArgs {
     /// Commit message.
     #[arg(long, default_value = "Upload hgym dataset")]
     message: String,
-    /// Retries per request on 429, 5xx and network failures (exponential backoff from 0.5 s).
+    /// Retries per request on 429, 5xx, network failures and time-outs (exponential backoff from
+    /// 0.5 s, or the server's Retry-After up to 60 s).
     #[arg(long, default_value_t = 5)]
     retries: u32,
+    /// Seconds one request may take (connecting: at most 10 of them), plus one second per MB it
+    /// uploads; a server silent for longer has timed out.
+    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u64).range(1..=3600))]
+    timeout: u64,
     /// Print the result as JSON.
     #[arg(long)]
     json: bool,
 }
 
-/// Token, repository and folder problems are the user's to fix (exit 2); the server's are not.
-fn classify(e: HubError) -> anyhow::Error {
-    match e {
-        HubError::NoToken | HubError::BadRepo(_) | HubError::Auth { .. } | HubError::Io(_) => UsageError(e.to_string()).into(),
-        other => other.into(),
-    }
-}
-
 pub fn run_push(args: PushArgs) -> Result<Outcome> {
-    hub::check_repo(&args.repo).map_err(classify)?;
-    let cfg = HubConfig::from_env(args.retries).map_err(classify)?;
+    hub::check_repo(&args.repo)?;
+    let cfg = HubConfig::from_env(args.retries, Duration::from_secs(args.timeout))?;
     let json = args.json;
     let report = hub::push(&args.dir, &args.repo, args.private, &args.message, &cfg, &mut |m| {
         if !json {
             eprintln!("{m}");
         }
-    })
-    .map_err(classify)?;
+    })?;
     if json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

@@ -11,16 +11,23 @@
 //!
 //! The token comes from `HF_TOKEN` (or `HUGGING_FACE_HUB_TOKEN`), else the file the Hugging Face
 //! tools write (`HF_TOKEN_PATH`, `$HF_HOME/token`, `~/.cache/huggingface/token`). It is sent
-//! only as a sensitive `Authorization` header to the endpoint and never formatted into any
-//! message. Requests are retried with exponential backoff (or the server's `Retry-After`) on
-//! 429, 5xx and connection failures; 401/403 stop at once with what to do.
+//! as a sensitive `Authorization` header only to the endpoint's exact origin (scheme, host and
+//! port, compared on parsed URLs), whatever address a reply names; redirects are followed only
+//! within a request's own origin; the endpoint must be `https://` (plain `http://` only on a
+//! loopback host); server text in messages is cut to 300 characters with token-shaped words
+//! redacted. Replies are parsed strictly: an answer without what the API returns (upload modes,
+//! LFS objects, the commit's ID) is an error, never a success. Requests are retried with
+//! exponential backoff (or the server's `Retry-After`, in whole seconds up to 60) on 429, 5xx,
+//! connection failures and time-outs; 401/403 stop at once with what to do.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use base64::Engine;
+use reqwest::Url;
 use serde_json::{json, Value};
 use sha2::{Digest, Sha256};
+use url::Origin;
 
 /// A Hub token. Its `Debug` does not show it.
 #[derive(Clone)]
@@ -38,42 +45,102 @@ pub enum HubError {
     NoToken,
     #[error("'{0}' is not a repository ID: use user/name or org/name (letters, digits, '-', '_', '.')")]
     BadRepo(String),
+    #[error("HF_ENDPOINT '{endpoint}' {problem}")]
+    Endpoint { endpoint: String, problem: String },
     #[error("the Hub refused the token ({status}) while {what}: {message}. Check HF_TOKEN (or the token file) and that it has write access to the repository")]
     Auth { status: u16, what: String, message: String },
     #[error("the Hub answered {status} while {what}: {message}")]
     Http { status: u16, what: String, message: String },
+    #[error("the Hub's answer while {what} is not what its API returns ({problem}); nothing was committed by this step. The answer began: {body}")]
+    Reply { what: String, problem: String, body: String },
+    #[error("the server redirected to {to} while {what}: not followed, because it is not {origin} (hgym follows redirects only within one origin, so the token never leaves the endpoint)")]
+    Redirect { what: String, origin: String, to: String },
+    #[error("timed out while {what}: no complete answer from {endpoint} within {seconds} s, {attempts} attempt(s) (a slow server: try again later, or raise --timeout)")]
+    TimedOut {
+        endpoint: String,
+        what: String,
+        seconds: u64,
+        attempts: u32,
+    },
     #[error("could not reach {endpoint} while {what}: {message} (set HF_ENDPOINT to use another server)")]
     Network { endpoint: String, what: String, message: String },
     #[error("{0}")]
     Io(String),
 }
 
+impl HubError {
+    /// Token, endpoint, repository and folder problems are the user's to fix (exit 2); the
+    /// server's are not.
+    pub fn is_bad_input(&self) -> bool {
+        matches!(
+            self,
+            HubError::NoToken | HubError::BadRepo(_) | HubError::Endpoint { .. } | HubError::Auth { .. } | HubError::Io(_)
+        )
+    }
+}
+
 /// Where and how to upload.
 #[derive(Clone, Debug)]
 pub struct HubConfig {
+    /// The endpoint without a trailing '/', e.g. `https://huggingface.co`.
     pub endpoint: String,
+    /// Its scheme, host and port: the only origin the token is sent to.
+    origin: Origin,
     pub token: Token,
     /// Retries per request after the first attempt.
     pub retries: u32,
     /// First backoff; doubles on every retry (capped at 30 s).
     pub backoff: Duration,
+    /// How long one request may take, plus one second per MB it uploads.
+    pub timeout: Duration,
 }
 
 impl HubConfig {
+    /// The endpoint `endpoint` with `token`: `https://`, or plain `http://` on a loopback host
+    /// only (a local test server), since the token would otherwise cross the network in clear.
+    pub fn new(endpoint: &str, token: Token, retries: u32, timeout: Duration) -> Result<HubConfig, HubError> {
+        let endpoint = endpoint.trim_end_matches('/').to_string();
+        let refuse = |problem: &str| HubError::Endpoint {
+            endpoint: endpoint.clone(),
+            problem: problem.to_string(),
+        };
+        let url = Url::parse(&endpoint).map_err(|e| refuse(&format!("is not a URL ({e}): use e.g. https://huggingface.co")))?;
+        let loopback = match url.host() {
+            Some(url::Host::Domain(d)) => d.eq_ignore_ascii_case("localhost"),
+            Some(url::Host::Ipv4(a)) => a.is_loopback(),
+            Some(url::Host::Ipv6(a)) => a.is_loopback(),
+            None => false,
+        };
+        match url.scheme() {
+            "https" if url.host().is_some() => {}
+            "http" if loopback => {}
+            "http" => {
+                return Err(refuse(
+                    "is plain http: the token would cross the network unencrypted. Use https:// (plain http is accepted only for a server on this machine: localhost, 127.0.0.1, ::1)",
+                ))
+            }
+            _ => return Err(refuse("is not an https:// address with a host: use e.g. https://huggingface.co")),
+        }
+        if !url.username().is_empty() || url.password().is_some() || url.query().is_some() {
+            return Err(refuse("carries credentials or a query: give the bare server address"));
+        }
+        Ok(HubConfig {
+            origin: url.origin(),
+            endpoint,
+            token,
+            retries,
+            backoff: Duration::from_millis(500),
+            timeout,
+        })
+    }
+
     /// Endpoint from `HF_ENDPOINT` (default `https://huggingface.co`), token as described above.
-    pub fn from_env(retries: u32) -> Result<HubConfig, HubError> {
+    pub fn from_env(retries: u32, timeout: Duration) -> Result<HubConfig, HubError> {
         let endpoint = std::env::var("HF_ENDPOINT")
             .ok()
             .filter(|s| !s.is_empty())
-            .unwrap_or_else(|| "https://huggingface.co".into())
-            .trim_end_matches('/')
-            .to_string();
-        Ok(HubConfig {
-            endpoint,
-            token: token_from_env()?,
-            retries,
-            backoff: Duration::from_millis(500),
-        })
+            .unwrap_or_else(|| "https://huggingface.co".into());
+        HubConfig::new(&endpoint, token_from_env()?, retries, timeout)
     }
 }
 
@@ -113,6 +180,38 @@ pub fn check_repo(repo: &str) -> Result<(&str, &str), HubError> {
     }
 }
 
+/// `text` (a server's words) for a message: at most 300 characters, with the token and anything
+/// shaped like a Hugging Face token (`hf_` and 8 or more letters or digits) replaced by `hf_***`.
+pub fn redact(text: &str, token: &Token) -> String {
+    let text: String = text.chars().take(300).collect();
+    let text = if token.0.is_empty() {
+        text
+    } else {
+        text.replace(&token.0, "hf_***")
+    };
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text.as_str();
+    while let Some(i) = rest.find("hf_") {
+        out.push_str(&rest[..i]);
+        let tail = &rest[i + 3..];
+        let n = tail.find(|c: char| !c.is_ascii_alphanumeric()).unwrap_or(tail.len());
+        out.push_str(if n >= 8 { "hf_***" } else { &rest[i..i + 3 + n] });
+        rest = &tail[n..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The `Retry-After` header's delay in seconds (RFC 9110: a non-negative integer), capped at
+/// 60 s; `None` for anything else (an HTTP date, garbage), which falls back to the backoff.
+pub fn retry_after(value: &str) -> Option<Duration> {
+    let v = value.trim();
+    if v.is_empty() || !v.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    Some(Duration::from_secs(v.parse::<u64>().unwrap_or(u64::MAX).min(60)))
+}
+
 /// One file to upload.
 struct Upload {
     path: String,
@@ -130,7 +229,7 @@ pub struct PushReport {
     pub lfs_files: usize,
     pub lfs_uploaded: usize,
     pub bytes: u64,
-    pub commit: Option<String>,
+    pub commit: String,
 }
 
 struct Client<'a> {
@@ -139,38 +238,54 @@ struct Client<'a> {
 }
 
 impl Client<'_> {
-    /// Sends `build()` until it succeeds, retrying on 429 / 5xx / network failures; 401/403 and
-    /// other 4xx are returned at once. `auth`: send the token (only to the Hub itself).
+    /// Sends `build()` until it succeeds, retrying on 429 / 5xx / network failures and time-outs;
+    /// 401/403 and other 4xx are returned at once. `auth`: the call carries the token, which is
+    /// attached only if the request's origin is the endpoint's. Returns the status and the body.
     fn send(
         &self,
         what: &str,
         auth: bool,
         build: &dyn Fn(&reqwest::blocking::Client) -> reqwest::blocking::RequestBuilder,
         accept: &[u16],
-    ) -> Result<(u16, Value), HubError> {
+    ) -> Result<(u16, String), HubError> {
         let mut attempt = 0;
         loop {
-            let mut req = build(&self.http);
-            if auth {
-                req = req.bearer_auth(&self.cfg.token.0);
+            let mut req = build(&self.http).build().map_err(|e| HubError::Reply {
+                what: what.into(),
+                problem: "it names an address that is not a URL".into(),
+                body: redact(&e.without_url().to_string(), &self.cfg.token),
+            })?;
+            if auth && req.url().origin() == self.cfg.origin {
+                let mut value = reqwest::header::HeaderValue::from_str(&format!("Bearer {}", self.cfg.token.0))
+                    .map_err(|_| HubError::Io("the token has characters an HTTP header cannot carry".into()))?;
+                value.set_sensitive(true);
+                req.headers_mut().insert(reqwest::header::AUTHORIZATION, value);
             }
-            let wait = match req.send() {
+            let wait = match self.http.execute(req) {
                 Ok(resp) => {
                     let status = resp.status().as_u16();
-                    let retry_after = resp
-                        .headers()
-                        .get("retry-after")
-                        .and_then(|v| v.to_str().ok())
-                        .and_then(|v| v.trim().parse::<f64>().ok());
-                    let text = resp.text().unwrap_or_default();
-                    let body: Value = serde_json::from_str(&text).unwrap_or(Value::Null);
+                    let header = |name: &str| resp.headers().get(name).and_then(|v| v.to_str().ok()).map(str::to_string);
+                    let (wait, location) = (header("retry-after").and_then(|v| retry_after(&v)), header("location"));
+                    let text = match resp.text() {
+                        Ok(t) => t,
+                        Err(e) if e.is_timeout() => return Err(self.timed_out(what, attempt)),
+                        Err(e) => return Err(self.network(what, e)),
+                    };
                     if (200..300).contains(&status) || accept.contains(&status) {
-                        return Ok((status, body));
+                        return Ok((status, text));
                     }
-                    let message = body["error"]
-                        .as_str()
-                        .map(|s| s.to_string())
-                        .unwrap_or_else(|| text.chars().take(300).collect());
+                    let message = serde_json::from_str::<Value>(&text)
+                        .ok()
+                        .and_then(|b| b["error"].as_str().map(str::to_string))
+                        .unwrap_or_else(|| text.clone());
+                    let message = redact(&message, &self.cfg.token);
+                    if (300..400).contains(&status) {
+                        return Err(HubError::Redirect {
+                            what: what.into(),
+                            origin: self.cfg.endpoint.clone(),
+                            to: redact(location.as_deref().unwrap_or("(no Location)"), &self.cfg.token),
+                        });
+                    }
                     if status == 401 || status == 403 {
                         return Err(HubError::Auth {
                             status,
@@ -185,22 +300,57 @@ impl Client<'_> {
                             message,
                         });
                     }
-                    retry_after.map(|s| Duration::from_secs_f64(s.clamp(0.0, 60.0)))
+                    wait
                 }
-                Err(e) => {
-                    if attempt >= self.cfg.retries {
-                        return Err(HubError::Network {
-                            endpoint: self.cfg.endpoint.clone(),
-                            what: what.into(),
-                            message: e.without_url().to_string(),
-                        });
-                    }
-                    None
+                Err(e) if attempt >= self.cfg.retries => {
+                    return Err(if e.is_timeout() {
+                        self.timed_out(what, attempt)
+                    } else {
+                        self.network(what, e)
+                    })
                 }
+                Err(_) => None,
             };
             let backoff = (self.cfg.backoff * 2u32.pow(attempt.min(6))).min(Duration::from_secs(30));
             std::thread::sleep(wait.unwrap_or(backoff));
             attempt += 1;
+        }
+    }
+
+    fn timed_out(&self, what: &str, attempt: u32) -> HubError {
+        HubError::TimedOut {
+            endpoint: self.cfg.endpoint.clone(),
+            what: what.into(),
+            seconds: self.cfg.timeout.as_secs(),
+            attempts: attempt + 1,
+        }
+    }
+
+    fn network(&self, what: &str, e: reqwest::Error) -> HubError {
+        HubError::Network {
+            endpoint: self.cfg.endpoint.clone(),
+            what: what.into(),
+            message: redact(&e.without_url().to_string(), &self.cfg.token),
+        }
+    }
+
+    /// A JSON object answer, or the error that says it is not one.
+    fn object(&self, what: &str, text: &str) -> Result<serde_json::Map<String, Value>, HubError> {
+        match serde_json::from_str::<Value>(text) {
+            Ok(Value::Object(m)) => Ok(m),
+            _ => Err(self.reply(what, "not a JSON object", text)),
+        }
+    }
+
+    fn reply(&self, what: &str, problem: &str, text: &str) -> HubError {
+        HubError::Reply {
+            what: what.into(),
+            problem: problem.into(),
+            body: if text.is_empty() {
+                "(empty)".into()
+            } else {
+                redact(text, &self.cfg.token)
+            },
         }
     }
 }
@@ -256,50 +406,68 @@ pub fn push(
     }
     let http = reqwest::blocking::Client::builder()
         .user_agent(concat!("hgym/", env!("CARGO_PKG_VERSION")))
-        .timeout(Duration::from_secs(600))
+        .connect_timeout(Duration::from_secs(10).min(cfg.timeout))
+        .timeout(cfg.timeout)
+        // Redirects within the request's own origin only: a reply never sends a request (and
+        // with it the token) somewhere else.
+        .redirect(reqwest::redirect::Policy::custom(|a| {
+            let same = a.previous().first().is_some_and(|first| first.origin() == a.url().origin());
+            if same && a.previous().len() <= 5 {
+                a.follow()
+            } else {
+                a.stop()
+            }
+        }))
         .build()
         .map_err(|e| HubError::Io(format!("cannot start the HTTP client: {e}")))?;
     let c = Client { http, cfg };
     let ep = cfg.endpoint.clone();
 
+    let what = "creating the repository";
     progress(&format!("creating dataset repo {repo} (if needed)"));
     let body = json!({"type": "dataset", "name": name, "organization": user, "private": private});
-    let (status, _) = c.send(
-        "creating the repository",
-        true,
-        &|h| h.post(format!("{ep}/api/repos/create")).json(&body),
-        &[409],
-    )?;
+    let (status, text) = c.send(what, true, &|h| h.post(format!("{ep}/api/repos/create")).json(&body), &[409])?;
     let created = status != 409;
+    if created {
+        c.object(what, &text)?;
+    }
 
+    let what = "asking for upload modes";
     progress(&format!("asking the Hub how to upload {} files", files.len()));
     let b64 = base64::engine::general_purpose::STANDARD;
     let pre = json!({"files": files.iter().map(|f| json!({
         "path": f.path, "size": f.bytes.len(), "sample": b64.encode(&f.bytes[..f.bytes.len().min(512)])
     })).collect::<Vec<_>>()});
-    let (_, modes) = c.send(
-        "asking for upload modes",
+    let (_, text) = c.send(
+        what,
         true,
         &|h| h.post(format!("{ep}/api/datasets/{repo}/preupload/main")).json(&pre),
         &[],
     )?;
-    let is_lfs = |path: &str| {
-        modes["files"]
-            .as_array()
-            .and_then(|a| a.iter().find(|m| m["path"] == path))
-            .map(|m| m["uploadMode"] == "lfs")
-            .unwrap_or(false)
-    };
-    let lfs: Vec<&Upload> = files.iter().filter(|f| is_lfs(&f.path)).collect();
+    let modes = c.object(what, &text)?;
+    let mut lfs: Vec<&Upload> = vec![];
+    for f in &files {
+        let mode = modes
+            .get("files")
+            .and_then(Value::as_array)
+            .and_then(|a| a.iter().find(|m| m["path"] == f.path.as_str()))
+            .and_then(|m| m["uploadMode"].as_str());
+        match mode {
+            Some("lfs") => lfs.push(f),
+            Some("regular") => {}
+            _ => return Err(c.reply(what, &format!("no upload mode 'lfs' or 'regular' for {}", f.path), &text)),
+        }
+    }
 
     let mut lfs_uploaded = 0;
     if !lfs.is_empty() {
+        let what = "requesting LFS uploads";
         let batch = json!({
             "operation": "upload", "transfers": ["basic"], "hash_algo": "sha256", "ref": {"name": "main"},
             "objects": lfs.iter().map(|f| json!({"oid": f.sha256, "size": f.bytes.len()})).collect::<Vec<_>>(),
         });
-        let (_, answer) = c.send(
-            "requesting LFS uploads",
+        let (_, text) = c.send(
+            what,
             true,
             &|h| {
                 h.post(format!("{ep}/datasets/{repo}.git/info/lfs/objects/batch"))
@@ -309,60 +477,70 @@ pub fn push(
             },
             &[],
         )?;
-        for obj in answer["objects"].as_array().cloned().unwrap_or_default() {
-            let oid = obj["oid"].as_str().unwrap_or("");
-            let Some(f) = lfs.iter().find(|f| f.sha256 == oid) else {
-                continue;
+        let answer = c.object(what, &text)?;
+        let objects = answer.get("objects").and_then(Value::as_array).cloned().unwrap_or_default();
+        for f in &lfs {
+            let Some(obj) = objects.iter().find(|o| o["oid"] == f.sha256.as_str()) else {
+                return Err(c.reply(what, &format!("no entry for {} ({})", f.path, f.sha256), &text));
             };
             if let Some(e) = obj.get("error") {
                 return Err(HubError::Http {
-                    status: e["code"].as_u64().unwrap_or(0) as u16,
+                    status: e["code"].as_u64().map_or(0, |c| c.min(999) as u16),
                     what: format!("uploading {}", f.path),
-                    message: e["message"].as_str().unwrap_or("").to_string(),
+                    message: redact(e["message"].as_str().unwrap_or(""), &cfg.token),
                 });
             }
             let Some(upload) = obj["actions"].get("upload") else {
                 continue; // the Hub has these bytes already
             };
+            let what = format!("uploading {}", f.path);
             if upload["header"].get("chunk_size").is_some() {
                 return Err(HubError::Io(format!(
                     "{} needs a multipart upload, which hgym does not do; split it with --shard-rows",
                     f.path
                 )));
             }
+            let Some(href) = upload["href"].as_str() else {
+                return Err(c.reply(&what, "the upload action has no href", &text));
+            };
+            let mut headers = vec![];
+            for (k, v) in upload["header"].as_object().into_iter().flatten() {
+                let Some(v) = v.as_str() else {
+                    return Err(c.reply(&what, &format!("the upload header {k} is not a string"), &text));
+                };
+                headers.push((k.clone(), v.to_string()));
+            }
             progress(&format!("uploading {} ({} bytes)", f.path, f.bytes.len()));
-            let href = upload["href"].as_str().unwrap_or("").to_string();
-            let headers = upload["header"].as_object().cloned().unwrap_or_default();
+            let seconds = cfg.timeout + Duration::from_secs(f.bytes.len() as u64 >> 20);
             c.send(
-                &format!("uploading {}", f.path),
+                &what,
                 false,
                 &|h| {
-                    let mut r = h.put(&href).body(f.bytes.clone());
+                    let mut r = h.put(href).timeout(seconds).body(f.bytes.clone());
                     for (k, v) in &headers {
-                        r = r.header(k.as_str(), v.as_str().unwrap_or(""));
+                        r = r.header(k.as_str(), v.as_str());
                     }
                     r
                 },
                 &[],
             )?;
             if let Some(verify) = obj["actions"].get("verify") {
-                let href = verify["href"].as_str().unwrap_or("").to_string();
+                let what = format!("verifying {}", f.path);
+                let Some(href) = verify["href"].as_str() else {
+                    return Err(c.reply(&what, "the verify action has no href", &text));
+                };
                 let body = json!({"oid": f.sha256, "size": f.bytes.len()});
-                c.send(
-                    &format!("verifying {}", f.path),
-                    href.starts_with(&ep),
-                    &|h| h.post(&href).json(&body),
-                    &[],
-                )?;
+                c.send(&what, true, &|h| h.post(href).json(&body), &[])?;
             }
             lfs_uploaded += 1;
         }
     }
 
-    progress("committing");
+    let what = "committing";
+    progress(what);
     let mut ndjson = json!({"key": "header", "value": {"summary": message, "description": ""}}).to_string();
     for f in &files {
-        let line = if is_lfs(&f.path) {
+        let line = if lfs.iter().any(|l| l.path == f.path) {
             json!({"key": "lfsFile", "value": {"path": f.path, "algo": "sha256", "oid": f.sha256, "size": f.bytes.len()}})
         } else {
             json!({"key": "file", "value": {"path": f.path, "encoding": "base64", "content": b64.encode(&f.bytes)}})
@@ -370,8 +548,8 @@ pub fn push(
         ndjson.push('\n');
         ndjson.push_str(&line.to_string());
     }
-    let (_, commit) = c.send(
-        "committing",
+    let (_, text) = c.send(
+        what,
         true,
         &|h| {
             h.post(format!("{ep}/api/datasets/{repo}/commit/main"))
@@ -380,6 +558,10 @@ pub fn push(
         },
         &[],
     )?;
+    let commit = c.object(what, &text)?;
+    let Some(commit) = commit.get("commitOid").and_then(Value::as_str) else {
+        return Err(c.reply(what, "no commitOid: the commit cannot be confirmed", &text));
+    };
     Ok(PushReport {
         repo: repo.to_string(),
         url: format!("{ep}/datasets/{repo}"),
@@ -388,7 +570,7 @@ pub fn push(
         lfs_files: lfs.len(),
         lfs_uploaded,
         bytes: files.iter().map(|f| f.bytes.len() as u64).sum(),
-        commit: commit["commitOid"].as_str().map(|s| s.to_string()),
+        commit: commit.to_string(),
     })
 }
 
@@ -401,6 +583,54 @@ mod tests {
         assert_eq!(check_repo("user/name-1.x").unwrap(), ("user", "name-1.x"));
         for bad in ["name", "/name", "user/", "a/b/c", "us er/x", "u/n?"] {
             assert!(check_repo(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn endpoints_are_https_or_loopback_http() {
+        let t = || Token("hf_x".into());
+        let d = Duration::from_secs(1);
+        for ok in [
+            "https://huggingface.co",
+            "https://hub.example:8443/",
+            "http://127.0.0.1:9",
+            "http://localhost:80",
+            "http://[::1]:5",
+        ] {
+            assert!(HubConfig::new(ok, t(), 0, d).is_ok(), "{ok}");
+        }
+        for bad in [
+            "http://huggingface.co",
+            "http://10.0.0.1",
+            "ftp://x",
+            "huggingface.co",
+            "https://u:p@h.co",
+            "file:///tmp",
+        ] {
+            let e = HubConfig::new(bad, t(), 0, d).err().unwrap_or_else(|| panic!("{bad} accepted"));
+            assert!(e.is_bad_input(), "{bad}");
+        }
+        let e = HubConfig::new("http://hub.example", t(), 0, d)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("plain http") && e.contains("https://"), "{e}");
+    }
+
+    #[test]
+    fn server_text_is_redacted() {
+        let t = Token("s3cr3t-token".into());
+        assert_eq!(redact("bad s3cr3t-token here", &t), "bad hf_*** here");
+        assert_eq!(redact("key hf_AbCdEf123456 and hf_ok", &t), "key hf_*** and hf_ok");
+        assert_eq!(redact(&"x".repeat(1000), &t).len(), 300);
+    }
+
+    #[test]
+    fn retry_after_is_seconds_or_nothing() {
+        assert_eq!(retry_after(" 3 "), Some(Duration::from_secs(3)));
+        assert_eq!(retry_after("99999999999999999999999"), Some(Duration::from_secs(60)));
+        for bad in ["NaN", "-1", "1.5", "inf", "", "Wed, 21 Oct 2015 07:28:00 GMT"] {
+            assert_eq!(retry_after(bad), None, "{bad}");
         }
     }
 

@@ -34,9 +34,17 @@ pub struct Trajectory {
     pub fields: Vec<super::field::Snapshot>,
 }
 
+/// The registry's ID syntax (`Cylinder_2D_Re100`): an ASCII letter, then letters, digits and
+/// '_', at most 64 in all. IDs from files are checked against it before they name a folder.
+pub fn is_env_id(s: &str) -> bool {
+    let mut c = s.chars();
+    s.len() <= 64 && c.next().is_some_and(|c| c.is_ascii_alphabetic()) && c.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
 impl Trajectory {
+    /// The manifest's environment ID ([`read`] checks it has the registry's syntax).
     pub fn env_id(&self) -> &str {
-        self.manifest.get("env_id").map(|s| s.as_str()).unwrap_or("unknown")
+        self.manifest.get("env_id").map_or("", |s| s.as_str())
     }
 
     /// The seed of episode `e`, when the manifest lists one seed per episode.
@@ -78,6 +86,22 @@ pub fn read(path: &Path) -> Result<Trajectory, DataError> {
         }
     } else {
         return Err(bad(&"no summary section: the file was not finished"));
+    }
+    match manifest.get("env_id") {
+        Some(id) if is_env_id(id) => {}
+        Some(id) => {
+            return Err(DataError::Format(format!(
+                "{}: the manifest's env_id {:?} is not an environment ID (a letter, then letters, digits and '_', at most 64); refused, since it would name a folder",
+                path.display(),
+                id.chars().take(80).collect::<String>()
+            )))
+        }
+        None => {
+            return Err(DataError::Format(format!(
+                "{}: its manifest has no env_id, so it is not a trajectory hgym wrote",
+                path.display()
+            )))
+        }
     }
     let mut rows: BTreeMap<(u64, u64), StepRow> = BTreeMap::new();
     let mut fields = vec![];

@@ -89,6 +89,12 @@ mod tests {
         ids.sort();
         ids.dedup();
         assert_eq!(ids.len(), specs.len());
+        for id in &ids {
+            assert!(crate::data::read::is_env_id(id), "{id} has the syntax files are checked against");
+        }
+        for bad in ["../x", "/abs", "", "1abc", "a/b", "a.b", "a-b", &"A".repeat(65)] {
+            assert!(!crate::data::read::is_env_id(bad), "{bad}");
+        }
         assert!(lookup("Cylinder_2D_Re100").is_ok());
         assert!(lookup("Kolmogorov_2D_Re40").is_ok());
         let EnvInputError::UnknownEnv { closest, .. } = lookup("Cylinder_2D_Re10").unwrap_err() else {
