@@ -218,6 +218,78 @@ fn sponges(edges: &[&str], thickness: f64) -> String {
         .collect()
 }
 
+/// Hostile case files (issue 36): sizes that would wrap or allocate terabytes, numbers that are
+/// not numbers, bodies that vanish, arrays with a third element, windows of no step, names that
+/// fail only at the end, a case with nothing to judge. Each is refused before anything runs
+/// (exit 2), naming the field.
+#[test]
+fn hostile_case_files_are_refused_before_running_naming_the_field() {
+    let tmp = tempfile::tempdir().unwrap();
+    let extra_body = |d: &str| format!("[[more_bodies]]\nshape = \"circle\"\ncenter = [30.0, 0.0]\ndiameter = {d}\n\n[domain]");
+    let long_name = format!("name = \"{}\"", "a".repeat(300));
+    let no_refs = {
+        let s = small_case(&[]);
+        s[..s.find("[[reference]]").unwrap()].to_string()
+    };
+    let cases: Vec<(&str, String, &str)> = vec![
+        (
+            "tiny_diameter",
+            small_case(&[("diameter = 1.0", "diameter = 1e-300")]),
+            "GB of populations",
+        ),
+        (
+            "huge_domain",
+            small_case(&[("x = [0.0, 60.0]", "x = [0.0, 1e300]")]),
+            "GB of populations",
+        ),
+        (
+            "wrapping_domain",
+            small_case(&[("x = [0.0, 60.0]", "x = [0.0, 4294967296.0]")]),
+            "limit is 50000000",
+        ),
+        ("huge_spin_up", small_case(&[("spin_up = 50.0", "spin_up = 1e300")]), "`time`"),
+        ("huge_average", small_case(&[("average = 40.0", "average = 1e9")]), "`time`"),
+        (
+            "long_run",
+            small_case(&[("average = 40.0", "average = 9e4"), ("coarse = 12", "coarse = 100")]),
+            "lattice steps",
+        ),
+        ("empty_window", small_case(&[("average = 40.0", "average = 1e-9")]), "at least 100"),
+        (
+            "three_numbers",
+            small_case(&[("x = [0.0, 60.0]", "x = [0.0, 60.0, 90.0]")]),
+            "expected two numbers",
+        ),
+        ("zero_body", small_case(&[("[domain]", &extra_body("0.0"))]), "body 2: diameter"),
+        ("nan_body", small_case(&[("[domain]", &extra_body("nan"))]), "body 2: diameter"),
+        (
+            "nan_center",
+            small_case(&[("center = [20.0, 0.0]", "center = [nan, 0.0]")]),
+            "body 1: center",
+        ),
+        ("nan_reference", small_case(&[("value = 0.165", "value = nan")]), "reference.value"),
+        ("inf_reference", small_case(&[("value = 0.165", "value = inf")]), "reference.value"),
+        ("zero_reference", small_case(&[("value = 0.165", "value = 0.0")]), "reference.value"),
+        ("long_name", small_case(&[("name = \"cylinder_re100\"", &long_name)]), "case.name"),
+    ];
+    for (name, body, words) in &cases {
+        let t0 = std::time::Instant::now();
+        let err = refused(tmp.path(), name, body);
+        assert!(err.contains(words), "{name}: {err}");
+        assert!(!err.contains("panicked") && err.len() < 2000, "{name}: {err}");
+        assert!(t0.elapsed().as_secs() < 10, "{name}: refused before running");
+    }
+    // Nothing to judge: measured, reported as UNJUDGED, never as PASS.
+    let no_refs = no_refs
+        .replace("spin_up = 50.0", "spin_up = 1.0")
+        .replace("average = 40.0", "average = 2.0");
+    let case = write_case(tmp.path(), "no_reference", &no_refs);
+    let o = run_coarse(&case, &tmp.path().join("no_reference_out"), false);
+    let (out, err) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{out}{err}");
+    assert!(out.contains("UNJUDGED") && !out.contains("PASS"), "{out}");
+}
+
 #[test]
 fn bad_absorbing_layers_are_refused_naming_the_problem() {
     let dir = tempfile::tempdir().unwrap();

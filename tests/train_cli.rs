@@ -198,6 +198,85 @@ fn baselines_evaluate_against_the_uncontrolled_flow() {
     assert!(r["actuation_cost"]["mean"].as_f64().unwrap() > 0.0);
 }
 
+/// Hostile overrides and arguments (issue 36): each is refused at once with exit 2, naming the
+/// field or flag; none runs, hangs, wraps or allocates.
+#[test]
+fn hostile_overrides_and_arguments_exit_2_at_once() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("runs");
+    let cfg = tmp.path().join("c.toml");
+    let overrides: &[(&str, &str, &str)] = &[
+        ("Cylinder_2D_Re100", "control_interval = 1e300", "control_interval"),
+        ("Cylinder_2D_Re100", "control_interval = 0.0", "control_interval"),
+        ("Cylinder_2D_Re100", "control_interval = -1.0", "control_interval"),
+        ("Cylinder_2D_Re100", "control_interval = nan", "control_interval"),
+        ("Cylinder_2D_Re100", "episode_actions = 0", "episode_actions"),
+        ("Cylinder_2D_Re100", "probes = []", "probes"),
+        ("Cylinder_2D_Re100", "probes = [[1.0, 2.0, 3.0]]", "two numbers"),
+        ("Cylinder_2D_Re100", "spin_up = -5.0", "spin_up"),
+        ("Kolmogorov_2D_Re40", "control_interval = nan", "control_interval"),
+        ("Kolmogorov_2D_Re40", "probes_per_side = 7", "probes_per_side"),
+        ("Kolmogorov_2D_Re40", "control_wavenumbers = [0]", "control_wavenumbers"),
+    ];
+    for (id, line, words) in overrides {
+        std::fs::write(&cfg, format!("[env]\n{line}\n")).unwrap();
+        let t0 = std::time::Instant::now();
+        let o = hgym(&[
+            "train",
+            "--env",
+            id,
+            "--config",
+            cfg.to_str().unwrap(),
+            "--steps",
+            "10",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{id} {line}: {}", text(&o));
+        assert!(text(&o).contains(words), "{id} {line}: {}", text(&o));
+        assert!(t0.elapsed().as_secs() < 10, "{id} {line}: refused before running");
+    }
+    assert!(!out.exists(), "no run folder for a refused override");
+    let missing = tmp.path().join("missing.toml");
+    let args: &[(&[&str], &str)] = &[
+        (
+            &["train", "--env", "Cylinder_2D_Re100", "--seeds", "0..18446744073709551615"],
+            "--seeds",
+        ),
+        (&["train", "--env", "Cylinder_2D_Re100", "--seeds", "0..1000000000"], "--seeds"),
+        (
+            &["train", "--env", "Cylinder_2D_Re100", "--seeds", "5..=18446744073709551615"],
+            "--seeds",
+        ),
+        (&["train", "--env", "Cylinder_2D_Re100", "--steps", "0"], "--steps"),
+        (
+            &["train", "--env", "Cylinder_2D_Re100", "--config", missing.to_str().unwrap()],
+            "missing.toml",
+        ),
+        (
+            &[
+                "eval",
+                "--policy",
+                "zero",
+                "--env",
+                "Cylinder_2D_Re100",
+                "--eval-seed",
+                "18446744073709551615",
+            ],
+            "--eval-seed",
+        ),
+    ];
+    for (a, words) in args {
+        let o = hgym(a);
+        assert_eq!(o.status.code(), Some(2), "{a:?}: {}", text(&o));
+        assert!(text(&o).contains(words), "{a:?}: {}", text(&o));
+    }
+    std::fs::write(&cfg, "[train]\nsteps = 0\n").unwrap();
+    let o = hgym(&["train", "--env", "Cylinder_2D_Re100", "--config", cfg.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("steps must be at least 1"), "{}", text(&o));
+}
+
 #[test]
 fn bad_training_input_is_named() {
     let o = hgym(&["train", "--env", "Cylindre_2D_Re100", "--steps", "10"]);

@@ -40,7 +40,7 @@ pub struct TrainArgs {
     #[arg(long)]
     seeds: Option<String>,
     /// Environment transitions to collect (default: the config's `train.steps`, 20000).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     steps: Option<u64>,
     /// Resolution level. Training defaults to coarse: the default level costs ~30x more per action.
     #[arg(long = "res", value_enum, default_value_t = Level::Coarse)]
@@ -114,27 +114,34 @@ pub fn install_interrupt() {
 }
 
 fn load_config(path: Option<&Path>) -> Result<TrainConfig> {
-    match path {
-        None => Ok(TrainConfig::default()),
-        Some(p) => {
-            let text = std::fs::read_to_string(p).with_context(|| format!("cannot read the config file {}", p.display()))?;
-            TrainConfig::parse(&text, &p.display().to_string()).map_err(anyhow::Error::from)
-        }
-    }
+    Ok(path.map_or_else(|| Ok(TrainConfig::default()), TrainConfig::load)?)
 }
 
-/// `0..3`, `0..=4`, `1,5,9`.
+/// Most seeds one `--seeds` may list (each is a whole training run).
+const MAX_SEEDS: u64 = 1000;
+
+/// `0..3`, `0..=4`, `1,5,9`: 1 to [`MAX_SEEDS`] seeds, counted before any list is made.
 fn parse_seeds(text: &str) -> Result<Vec<u64>> {
-    let bad = || UsageError(format!("--seeds {text}: expected a range like 0..3 or 0..=4, or a list like 1,5,9"));
+    let bad = || {
+        UsageError(format!(
+            "--seeds {text}: expected a range like 0..3 or 0..=4, or a list like 1,5,9, of 1 to {MAX_SEEDS} seeds"
+        ))
+    };
     let num = |s: &str| s.trim().parse::<u64>().map_err(|_| bad());
+    let range = |a: u64, end: Option<u64>| -> Result<Vec<u64>> {
+        match end {
+            Some(end) if end > a && end - a <= MAX_SEEDS => Ok((a..end).collect()),
+            _ => Err(bad().into()),
+        }
+    };
     let seeds: Vec<u64> = if let Some((a, b)) = text.split_once("..=") {
-        (num(a)?..=num(b)?).collect()
+        range(num(a)?, num(b)?.checked_add(1))?
     } else if let Some((a, b)) = text.split_once("..") {
-        (num(a)?..num(b)?).collect()
+        range(num(a)?, Some(num(b)?))?
     } else {
         text.split(',').map(num).collect::<Result<_, _>>()?
     };
-    if seeds.is_empty() {
+    if seeds.is_empty() || seeds.len() as u64 > MAX_SEEDS {
         return Err(bad().into());
     }
     Ok(seeds)
@@ -351,6 +358,15 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
     };
     let (pool, threads) = thread_pool(args.threads)?;
     let started = std::time::Instant::now();
+    if args.eval_seed.checked_add(args.episodes as u64).is_none() {
+        return Err(UsageError(format!(
+            "--eval-seed {} + --episodes {} passes the largest seed ({}): give a smaller --eval-seed",
+            args.eval_seed,
+            args.episodes,
+            u64::MAX
+        ))
+        .into());
+    }
     let seeds: Vec<u64> = (0..args.episodes as u64).map(|k| args.eval_seed + k).collect();
     let pb = progress_bar(2 * args.episodes as u64, spec.id());
     let slug: String = args

@@ -10,7 +10,7 @@ use super::progress::Progress;
 use crate::{thread_pool, Outcome, UsageError};
 use hgym::fidelity::{self, Entry};
 use hgym::flow::Level;
-use hgym::validate::{self, LoadedCase, Options, Status, ValidationReport};
+use hgym::validate::{self, LoadedCase, Options, ValidationReport};
 
 #[derive(Args)]
 pub struct ValidateArgs {
@@ -117,7 +117,7 @@ pub fn run(args: ValidateArgs) -> Result<Outcome> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&reports)?);
     }
-    let all_pass = reports.iter().all(|r| r.status == Status::Pass);
+    let all_pass = reports.iter().all(|r| r.status.is_ok());
     Ok(if all_pass { Outcome::Ok } else { Outcome::CheckFailed })
 }
 
@@ -195,6 +195,6 @@ fn run_envs(args: &ValidateArgs) -> Result<Outcome> {
             println!("recorded {} rows in {} (rebuild to embed)", rows.len(), args.table.display());
         }
     }
-    let all_pass = reports.iter().all(|r| r.status == Status::Pass);
+    let all_pass = reports.iter().all(|r| r.status.is_ok());
     Ok(if all_pass { Outcome::Ok } else { Outcome::CheckFailed })
 }

@@ -74,6 +74,21 @@ pub trait FamilySpec: Any + Send + Sync + std::fmt::Debug {
     fn as_any(&self) -> &dyn Any;
 }
 
+/// The episode fields every family shares, checked: a control interval in (0, 1000] time units,
+/// 1 to 10^7 actions per episode, a spin-up in [0, 10^5].
+pub fn check_episode(control_interval: f64, episode_actions: usize, spin_up: f64) -> Result<(), String> {
+    if !(control_interval.is_finite() && control_interval > 0.0 && control_interval <= 1e3) {
+        return Err(format!("control_interval must be a time in (0, 1000], got {control_interval}"));
+    }
+    if !(1..=10_000_000).contains(&episode_actions) {
+        return Err(format!("episode_actions must be 1 to 10000000, got {episode_actions}"));
+    }
+    if !(spin_up.is_finite() && (0.0..=1e5).contains(&spin_up)) {
+        return Err(format!("spin_up must be a time in [0, 100000], got {spin_up}"));
+    }
+    Ok(())
+}
+
 /// Why a calibration did not record its statistics.
 #[derive(Debug, thiserror::Error)]
 pub enum CalibrateError {

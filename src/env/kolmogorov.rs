@@ -89,6 +89,40 @@ pub struct KolmogorovSpec {
 }
 
 impl KolmogorovSpec {
+    /// The checks [`KolmogorovEnv::new`] would otherwise meet late: positive finite Re, step and
+    /// amplitude; control wavenumbers 1 to 7; probes that sit on every level's grid; the episode.
+    pub fn check(&self) -> Result<(), String> {
+        super::family::check_episode(self.control_interval, self.episode_actions, self.spin_up)?;
+        for (key, v) in [
+            ("reynolds", self.reynolds),
+            ("dt_at_64", self.dt_at_64),
+            ("max_amplitude", self.max_amplitude),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{key} must be a positive number, got {v}"));
+            }
+        }
+        if !(self.action_penalty.is_finite() && self.action_penalty >= 0.0) {
+            return Err(format!("action_penalty must be zero or positive, got {}", self.action_penalty));
+        }
+        if self.control_wavenumbers.is_empty() || self.control_wavenumbers.iter().any(|k| !(1..=7).contains(k)) {
+            return Err(format!(
+                "control_wavenumbers must list wavenumbers 1 to 7, got {:?}",
+                self.control_wavenumbers
+            ));
+        }
+        for level in [Level::Coarse, Level::Default, Level::Fine] {
+            let n = self.n(level);
+            if self.probes_per_side == 0 || !n.is_multiple_of(self.probes_per_side) {
+                return Err(format!(
+                    "probes_per_side = {} does not divide the {n}-point grid of the {level:?} level",
+                    self.probes_per_side
+                ));
+            }
+        }
+        Ok(())
+    }
+
     pub fn hash(&self) -> String {
         let json = serde_json::to_string(self).unwrap_or_default();
         format!("{:x}", Sha256::digest(json.as_bytes()))
@@ -198,7 +232,12 @@ impl FamilySpec for KolmogorovSpec {
     }
 
     fn with_overrides(&self, over: &toml::Table) -> Result<Spec, EnvInputError> {
-        Ok(Spec::new(merged(self, over, &self.id)?))
+        let spec: KolmogorovSpec = merged(self, over, &self.id)?;
+        spec.check().map_err(|message| EnvInputError::Override {
+            id: self.id.clone(),
+            message,
+        })?;
+        Ok(Spec::new(spec))
     }
 
     fn make(&self, level: Level, _cache: Option<PathBuf>) -> Result<Box<dyn FlowEnv>, EnvError> {

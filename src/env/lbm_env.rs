@@ -686,7 +686,12 @@ impl FamilySpec for EnvSpec {
     }
 
     fn with_overrides(&self, over: &toml::Table) -> Result<Spec, EnvInputError> {
-        Ok(Spec::new(merged(self, over, &self.id)?))
+        let spec: EnvSpec = merged(self, over, &self.id)?;
+        spec.check().map_err(|message| EnvInputError::Override {
+            id: self.id.clone(),
+            message,
+        })?;
+        Ok(Spec::new(spec))
     }
 
     fn make(&self, level: Level, cache: Option<PathBuf>) -> Result<Box<dyn FlowEnv>, EnvError> {

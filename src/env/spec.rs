@@ -22,6 +22,7 @@ pub enum ActuationSpec {
     /// Bound: `max_velocity` in units of U (peak of the parabolic jet profile).
     ZnmfJets {
         body: usize,
+        #[serde(deserialize_with = "crate::flow::pair")]
         angles_deg: [f64; 2],
         span_deg: f64,
         max_velocity: f64,
@@ -30,6 +31,7 @@ pub enum ActuationSpec {
     /// one action per body. Bound: `max_velocity` in units of U.
     ZnmfJetsPerBody {
         bodies: Vec<usize>,
+        #[serde(deserialize_with = "crate::flow::pair")]
         angles_deg: [f64; 2],
         span_deg: f64,
         max_velocity: f64,
@@ -106,6 +108,7 @@ pub struct EnvSpec {
     /// Smoothing of each action change over the control interval.
     pub ramp: Ramp,
     /// Point probes of (u, v, p); the observation is their values in this order.
+    #[serde(deserialize_with = "crate::flow::pairs")]
     pub probes: Vec<[f64; 2]>,
     pub reward: RewardSpec,
     /// Physical time between actions (L/U); the solver steps per action follow from it.
@@ -218,6 +221,20 @@ impl EnvSpec {
             _ => return None,
         };
         Some(format!("{base}_re{}", self.reynolds.round() as i64))
+    }
+
+    /// Every field a `--config` can change, checked before anything is built: the flow (as
+    /// validation checks it), the episode, and probes (at least one, at finite positions).
+    pub fn check(&self) -> Result<(), String> {
+        self.flow_setup().check().map_err(|e| e.to_string())?;
+        super::family::check_episode(self.control_interval, self.episode_actions, self.spin_up)?;
+        if self.probes.is_empty() {
+            return Err("probes must list at least one [x, y] position (the observation)".into());
+        }
+        if let Some(p) = self.probes.iter().find(|p| p.iter().any(|v| !v.is_finite())) {
+            return Err(format!("probe {p:?} is not a finite position"));
+        }
+        Ok(())
     }
 
     /// The flow this environment runs (what `FlowSetup::build` makes its solver from): a

@@ -7,7 +7,9 @@ use hgym_solvers::lbm::{Side, Sides};
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct DomainSpec {
+    #[serde(deserialize_with = "super::pair")]
     pub x: [f64; 2],
+    #[serde(deserialize_with = "super::pair")]
     pub y: [f64; 2],
 }
 

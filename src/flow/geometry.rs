@@ -14,22 +14,26 @@ use hgym_solvers::geometry::{Circle, Naca4, OpenCavity, Rectangle, Shape, Stenos
 #[serde(tag = "shape", rename_all = "lowercase", deny_unknown_fields)]
 pub enum GeometrySpec {
     Circle {
+        #[serde(deserialize_with = "super::pair")]
         center: [f64; 2],
         diameter: f64,
     },
     Square {
+        #[serde(deserialize_with = "super::pair")]
         center: [f64; 2],
         side: f64,
     },
     Naca {
         digits: String,
         chord: f64,
+        #[serde(deserialize_with = "super::pair")]
         leading_edge: [f64; 2],
         aoa_deg: f64,
     },
     /// An open cavity cut into a flat wall `y = leading_edge[1]` (the plate upstream and
     /// downstream of it is solid down to the domain's bottom); reference length: the depth.
     Cavity {
+        #[serde(deserialize_with = "super::pair")]
         leading_edge: [f64; 2],
         length: f64,
         depth: f64,
@@ -37,6 +41,7 @@ pub enum GeometrySpec {
     /// A cosine constriction of a straight channel (the domain's walls) with its throat at
     /// `center`; reference length: the channel width.
     Stenosis {
+        #[serde(deserialize_with = "super::pair")]
         center: [f64; 2],
         width: f64,
         length: f64,
@@ -45,6 +50,79 @@ pub enum GeometrySpec {
 }
 
 impl GeometrySpec {
+    /// Finite coordinates, positive lengths, an angle of attack within +-90 degrees, a NACA code
+    /// with a thickness, a stenosis that leaves the channel open (severity in [0, 0.5)); the
+    /// message names the key.
+    pub fn check(&self) -> Result<(), String> {
+        let finite = |key: &str, p: &[f64; 2]| {
+            if p.iter().all(|v| v.is_finite()) {
+                Ok(())
+            } else {
+                Err(format!("{key} must be two finite numbers, got {p:?}"))
+            }
+        };
+        let positive = |key: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{key} must be a positive length, got {v}"))
+            }
+        };
+        match self {
+            GeometrySpec::Circle { center, diameter } => {
+                finite("center", center)?;
+                positive("diameter", *diameter)
+            }
+            GeometrySpec::Square { center, side } => {
+                finite("center", center)?;
+                positive("side", *side)
+            }
+            GeometrySpec::Naca {
+                digits,
+                chord,
+                leading_edge,
+                aoa_deg,
+            } => {
+                finite("leading_edge", leading_edge)?;
+                positive("chord", *chord)?;
+                if !(aoa_deg.is_finite() && aoa_deg.abs() <= 90.0) {
+                    return Err(format!("aoa_deg must be an angle within -90 to 90 degrees, got {aoa_deg}"));
+                }
+                if Naca4::from_digits(digits, 1.0, [0.0, 0.0], 0.0).is_none() || digits.ends_with("00") {
+                    return Err(format!(
+                        "digits '{digits}' is not a NACA 4-digit code with a thickness (e.g. \"0012\": the last two digits are the thickness in % of the chord)"
+                    ));
+                }
+                Ok(())
+            }
+            GeometrySpec::Cavity {
+                leading_edge,
+                length,
+                depth,
+            } => {
+                finite("leading_edge", leading_edge)?;
+                positive("length", *length)?;
+                positive("depth", *depth)
+            }
+            GeometrySpec::Stenosis {
+                center,
+                width,
+                length,
+                severity,
+            } => {
+                finite("center", center)?;
+                positive("width", *width)?;
+                positive("length", *length)?;
+                if !(severity.is_finite() && (0.0..0.5).contains(severity)) {
+                    return Err(format!(
+                        "severity must be in [0, 0.5) (0.25 halves the width at the throat; 0.5 closes it), got {severity}"
+                    ));
+                }
+                Ok(())
+            }
+        }
+    }
+
     pub fn reference_length(&self) -> f64 {
         match self {
             GeometrySpec::Circle { diameter, .. } => *diameter,

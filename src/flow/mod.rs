@@ -20,7 +20,7 @@ pub mod inlet;
 pub mod level;
 pub mod plan;
 
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize};
 use thiserror::Error;
 
 use hgym_solvers::lbm::{Collision, LbmError};
@@ -32,6 +32,21 @@ pub use geometry::GeometrySpec;
 pub use inlet::{InletSpec, Profile, VelocityReference};
 pub use level::{Level, ResolutionSpec};
 pub use plan::{FlowPlan, RefinementPlan, RefinementSpec, MAX_LATTICE_SPEED, MAX_NODES};
+
+/// `[a, b]` and nothing else: TOML readers fill a fixed-size array from the front and drop what
+/// follows, so `x = [0, 60, 90]` would silently lose its third number.
+pub fn pair<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    let v = Vec::<f64>::deserialize(d)?;
+    <[f64; 2]>::try_from(v.as_slice()).map_err(|_| serde::de::Error::invalid_length(v.len(), &"two numbers [a, b]"))
+}
+
+/// A list of `[a, b]` pairs, each checked as [`pair`] checks one.
+pub fn pairs<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+    let v = Vec::<Vec<f64>>::deserialize(d)?;
+    v.iter()
+        .map(|p| <[f64; 2]>::try_from(p.as_slice()).map_err(|_| serde::de::Error::invalid_length(p.len(), &"two numbers [a, b]")))
+        .collect()
+}
 
 /// A flow that cannot be set up. `field` names the set-up's field (as [`FlowSetup`] calls it);
 /// the message says what is wrong and how to fix it.
@@ -126,20 +141,10 @@ impl FlowSetup {
                 "give at least one body: the first one's length is the reference length",
             ));
         };
+        for (i, g) in self.bodies.iter().enumerate() {
+            g.check().map_err(|m| bad("bodies", format!("body {}: {m}", i + 1)))?;
+        }
         let l = first.reference_length();
-        if !(l.is_finite() && l > 0.0) {
-            return Err(bad(
-                "bodies",
-                format!("the reference length (diameter, side or chord) must be positive, got {l}"),
-            ));
-        }
-        for g in &self.bodies {
-            if let GeometrySpec::Naca { digits, .. } = g {
-                if hgym_solvers::geometry::Naca4::from_digits(digits, 1.0, [0.0, 0.0], 0.0).is_none() {
-                    return Err(bad("bodies", format!("'{digits}' is not a NACA 4-digit code (e.g. \"0012\")")));
-                }
-            }
-        }
         let r = &self.resolution;
         for (lvl, n) in [("coarse", r.coarse), ("default", r.default), ("fine", r.fine)] {
             if n < 4 {

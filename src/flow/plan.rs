@@ -13,6 +13,17 @@ use super::{DomainSpec, FlowError, FlowSetup, Level};
 pub const MAX_LATTICE_SPEED: f64 = 0.173;
 /// Largest grid accepted (nodes), about 3.6 GB of populations.
 pub const MAX_NODES: usize = 50_000_000;
+/// Bytes of populations per node: nine f32 values, in two copies.
+pub const BYTES_PER_NODE: usize = 72;
+
+/// A cell count as digits while it is readable, else in scientific notation.
+fn count(v: f64) -> String {
+    if v < 1e9 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.3e}")
+    }
+}
 
 /// Nested refined rectangles `[x0, x1, y0, y1]` (reference lengths), coarsest first: inside the
 /// first the grid is twice as fine as the level's (`cells_per_length` applies outside), inside
@@ -116,7 +127,13 @@ impl FlowSetup {
         if !(nx_f * ny_f <= MAX_NODES as f64) {
             return Err(FlowError::Invalid {
                 field: "resolution",
-                message: format!("{nx_f:.0} x {ny_f:.0} cells exceeds the limit of {MAX_NODES}; use a coarser level or a smaller domain"),
+                message: format!(
+                    "{} x {} cells would need {} GB of populations ({BYTES_PER_NODE} bytes per cell); the limit is {MAX_NODES} cells ({:.1} GB): use a coarser level or a smaller domain",
+                    count(nx_f),
+                    count(ny_f),
+                    count(nx_f * ny_f * BYTES_PER_NODE as f64 / 1e9),
+                    (MAX_NODES * BYTES_PER_NODE) as f64 / 1e9
+                ),
             });
         }
         let (nx, ny) = (nx_f.round() as usize, ny_f.round() as usize);

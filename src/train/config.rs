@@ -45,6 +45,14 @@ impl Default for TrainSettings {
 /// A configuration file that cannot be used (always the user's input).
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
+    #[error("cannot read the config file {}", path.display())]
+    Read {
+        path: std::path::PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{origin}: {message}")]
+    Invalid { origin: String, message: String },
     #[error("{origin}: {source}")]
     Toml {
         origin: String,
@@ -97,7 +105,22 @@ impl TrainConfig {
             origin: origin.to_string(),
             source,
         })?;
+        if c.train.steps == 0 {
+            return Err(ConfigError::Invalid {
+                origin: origin.to_string(),
+                message: "[train] steps must be at least 1 (a run of no step would write an untrained policy)".into(),
+            });
+        }
         Ok(c)
+    }
+
+    /// Reads and parses the file `path`.
+    pub fn load(path: &std::path::Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(&text, &path.display().to_string())
     }
 
     pub fn to_toml(&self) -> String {

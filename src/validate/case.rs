@@ -298,8 +298,9 @@ pub struct LoadedCase {
 }
 
 fn bad(case: &str, field: &str, message: impl Into<String>) -> ValidateError {
+    let shown: String = case.chars().take(MAX_NAME).collect();
     ValidateError::Unrunnable {
-        case: case.to_string(),
+        case: if shown.len() < case.len() { shown + "..." } else { shown },
         field: field.to_string(),
         message: message.into(),
     }
@@ -326,11 +327,11 @@ impl LoadedCase {
     pub(crate) fn check_static(&self) -> Result<(), ValidateError> {
         let c = &self.case;
         let name = c.case.name.as_str();
-        if name.is_empty() || !name.chars().all(|ch| ch.is_ascii_alphanumeric() || ch == '_' || ch == '-') {
+        if name.is_empty() || name.len() > MAX_NAME || !name.chars().all(|ch| ch.is_ascii_alphanumeric() || ch == '_' || ch == '-') {
             return Err(bad(
                 name,
                 "case.name",
-                "use letters, digits, '_' and '-' only (it names the output files)",
+                format!("use 1 to {MAX_NAME} letters, digits, '_' and '-' (it names the output files)"),
             ));
         }
         c.flow_setup().check().map_err(|e| flow_error(name, e))?;
@@ -338,8 +339,15 @@ impl LoadedCase {
             return Err(bad(name, "flow.perturbation", "must be between -1 and 1 (a fraction of U)"));
         }
         let t = &c.time;
-        if !(t.spin_up.is_finite() && t.spin_up >= 0.0 && t.average.is_finite() && t.average > 0.0) {
-            return Err(bad(name, "time", "spin_up must be >= 0 and average > 0"));
+        if !(t.spin_up.is_finite() && t.spin_up >= 0.0 && t.average.is_finite() && t.average > 0.0) || t.spin_up.max(t.average) > MAX_TIME {
+            return Err(bad(
+                name,
+                "time",
+                format!(
+                    "spin_up must be in [0, {MAX_TIME:e}] and average in (0, {MAX_TIME:e}] (times in L/U), got {:e} and {:e}",
+                    t.spin_up, t.average
+                ),
+            ));
         }
         if c.measure.quantities.is_empty() {
             return Err(bad(name, "measure.quantities", "list at least one quantity"));
@@ -352,6 +360,17 @@ impl LoadedCase {
                     format!(
                         "'{}' has a reference but is not in measure.quantities; add it there",
                         r.quantity.name()
+                    ),
+                ));
+            }
+            if !r.value.is_finite() || (r.value == 0.0 && r.tolerance.is_some()) {
+                return Err(bad(
+                    name,
+                    "reference.value",
+                    format!(
+                        "'{}': the value must be a finite number, and not 0 with a relative tolerance (use abs_tolerance), got {}",
+                        r.quantity.name(),
+                        r.value
                     ),
                 ));
             }
@@ -413,6 +432,11 @@ impl LoadedCase {
         self.case.resolution.at(level)
     }
 }
+
+/// Longest case name (it names the output files).
+pub const MAX_NAME: usize = 64;
+/// Longest spin-up or averaging time, in L/U.
+pub const MAX_TIME: f64 = 1e5;
 
 /// Reads and parses a case file.
 pub fn load_file(path: &std::path::Path) -> Result<LoadedCase, ValidateError> {

@@ -20,6 +20,15 @@ pub enum Status {
     Pass,
     Fail,
     Diverged,
+    /// Completed with no judged reference: measured, not validated.
+    Unjudged,
+}
+
+impl Status {
+    /// Whether the run met everything it was judged on (exit 0): passed, or only measured.
+    pub fn is_ok(self) -> bool {
+        matches!(self, Status::Pass | Status::Unjudged)
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -231,7 +240,12 @@ impl ValidationReport {
         let (status, message) = match &out.status {
             RunStatus::Diverged { message, .. } => (Status::Diverged, Some(message.clone())),
             RunStatus::Completed => {
-                if !quantities.iter().any(QuantityResult::fails) {
+                if !quantities.iter().any(|q| q.judged && q.reference.is_some()) {
+                    (
+                        Status::Unjudged,
+                        Some("no judged reference: these are measurements, not a validation".to_string()),
+                    )
+                } else if !quantities.iter().any(QuantityResult::fails) {
                     (Status::Pass, None)
                 } else {
                     let failed: Vec<String> = quantities.iter().filter(|q| q.fails()).map(|q| q.name.clone()).collect();
@@ -343,6 +357,7 @@ impl ValidationReport {
                 Status::Pass => "PASS",
                 Status::Fail => "FAIL",
                 Status::Diverged => "DIVERGED",
+                Status::Unjudged => "UNJUDGED",
             }
         );
         if let Some(r) = &self.parameters.refinement {

@@ -15,6 +15,11 @@ use super::case::{flow_error, Level, LoadedCase};
 use super::ValidateError;
 use crate::flow::{vorticity_field, Field, FlowPlan};
 
+/// Most lattice steps a case may run (its force series hold 8 bytes per step and series).
+pub const MAX_STEPS: u64 = 20_000_000;
+/// Fewest lattice steps in an averaging window.
+pub const MIN_AVERAGE_STEPS: u64 = 100;
+
 /// Lattice numbers of a case at one level: its flow's, and the steps of the spin-up and the run.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Plan {
@@ -27,7 +32,31 @@ impl Plan {
     pub fn new(c: &LoadedCase, level: Level) -> Result<Self, ValidateError> {
         let case = &c.case;
         let flow = case.flow_setup().plan(level).map_err(|e| flow_error(&case.case.name, e))?;
-        // Time is in units of L/U.
+        // Time is in units of L/U; counted in floating point first, so that no count wraps.
+        let per_step = flow.units.time_per_step();
+        let (spin_up, average) = (case.time.spin_up / per_step, case.time.average / per_step);
+        let refuse = |message: String| ValidateError::Unrunnable {
+            case: case.case.name.clone(),
+            field: "time".into(),
+            message,
+        };
+        if spin_up + average > MAX_STEPS as f64 {
+            let series = (3 + 2 * (1 + case.more_bodies.len())) as f64 * 8.0 * (spin_up + average);
+            return Err(refuse(format!(
+                "spin_up + average = {} L/U is {:.3e} lattice steps at level {level:?} ({:.1} GB of force series); the limit is {MAX_STEPS} steps: shorten the times or use a coarser level",
+                case.time.spin_up + case.time.average,
+                spin_up + average,
+                series / 1e9
+            )));
+        }
+        if average.round() < MIN_AVERAGE_STEPS as f64 {
+            return Err(refuse(format!(
+                "average = {} L/U is {} lattice steps at level {level:?}; the window needs at least {MIN_AVERAGE_STEPS} (average >= {:.3})",
+                case.time.average,
+                average.round(),
+                MIN_AVERAGE_STEPS as f64 * per_step
+            )));
+        }
         let spin_up_steps = flow.units.steps(case.time.spin_up);
         let total_steps = spin_up_steps + flow.units.steps(case.time.average);
         Ok(Plan {
