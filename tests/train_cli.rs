@@ -277,6 +277,81 @@ fn hostile_overrides_and_arguments_exit_2_at_once() {
     assert!(text(&o).contains("steps must be at least 1"), "{}", text(&o));
 }
 
+/// Hostile policies and baselines (issue 36): a policy file with empty sizes, short or extra
+/// parameters, a zero width, NaN weights or an `obs_norm` of the wrong length, and baselines
+/// with infinite, NaN or out-of-range numbers or signals the flow does not have: exit 2 at once,
+/// naming the problem, never a panic and never a silent zero.
+#[test]
+fn hostile_policies_and_baselines_exit_2_naming_the_problem() {
+    let tmp = tempfile::tempdir().unwrap();
+    let good = common::repo().join("results/train/Cylinder_2D_Re100-ppo-coarse/seed1/policy.json");
+    let base: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(good).unwrap()).unwrap();
+    let edits: Vec<(&str, Box<dyn Fn(&mut serde_json::Value)>, &str)> = vec![
+        (
+            "empty_sizes",
+            Box::new(|p| p["net"]["sizes"] = serde_json::json!([])),
+            "input and an output size",
+        ),
+        ("zero_width", Box::new(|p| p["net"]["sizes"][1] = 0.into()), "a width of 0"),
+        (
+            "short_params",
+            Box::new(|p| {
+                p["net"]["params"].as_array_mut().unwrap().pop();
+            }),
+            "parameters",
+        ),
+        (
+            "extra_params",
+            Box::new(|p| p["net"]["params"].as_array_mut().unwrap().push(0.5.into())),
+            "parameters",
+        ),
+        (
+            "short_obs_norm",
+            Box::new(|p| {
+                p["obs_norm"]["mean"].as_array_mut().unwrap().pop();
+            }),
+            "obs_norm",
+        ),
+        (
+            "huge_width",
+            Box::new(|p| p["net"]["sizes"][1] = 4_000_000_000_000u64.into()),
+            "a width of",
+        ),
+    ];
+    for (name, edit, words) in &edits {
+        let mut p = base.clone();
+        edit(&mut p);
+        let file = tmp.path().join(format!("{name}.json"));
+        std::fs::write(&file, p.to_string()).unwrap();
+        let o = hgym(&[
+            "eval",
+            "--policy",
+            file.to_str().unwrap(),
+            "--env",
+            "Cylinder_2D_Re100",
+            "--episodes",
+            "1",
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{name}: {}", text(&o));
+        assert!(text(&o).contains(words) && !text(&o).contains("panicked"), "{name}: {}", text(&o));
+    }
+    for (policy, words) in [
+        ("constant=inf", "not a finite number"),
+        ("constant=1e308", "outside the normalised action range"),
+        ("constant=nan", "not a finite number"),
+        ("sine=nan", "not a finite number"),
+        ("sine=0", "must be positive"),
+        ("pd=obs:999,1,0", "obs:999 does not exist"),
+        ("pd=NOPE,1,0", "'NOPE' is not in the environment's info"),
+    ] {
+        let t0 = std::time::Instant::now();
+        let o = hgym(&["eval", "--policy", policy, "--env", "Cylinder_2D_Re100", "--episodes", "1"]);
+        assert_eq!(o.status.code(), Some(2), "{policy}: {}", text(&o));
+        assert!(text(&o).contains(words), "{policy}: {}", text(&o));
+        assert!(t0.elapsed().as_secs() < 60, "{policy}: refused before the reference episode");
+    }
+}
+
 #[test]
 fn bad_training_input_is_named() {
     let o = hgym(&["train", "--env", "Cylindre_2D_Re100", "--steps", "10"]);

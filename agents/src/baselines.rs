@@ -62,6 +62,28 @@ impl BaselinePolicy {
 }
 
 impl Policy for BaselinePolicy {
+    fn check(&self, obs: &[f64], info: &Info) -> Result<(), String> {
+        match &self.baseline {
+            Baseline::Pd {
+                signal: Signal::Obs(i), ..
+            } if *i >= obs.len() => Err(format!(
+                "the signal obs:{i} does not exist: the observation has {} values (obs:0 to obs:{})",
+                obs.len(),
+                obs.len().saturating_sub(1)
+            )),
+            Baseline::Pd {
+                signal: Signal::Info(key), ..
+            } if info.get(key).is_none() => {
+                let keys: Vec<&str> = info.values.keys().map(String::as_str).collect();
+                Err(format!(
+                    "the signal '{key}' is not in the environment's info; it has: {}",
+                    keys.join(", ")
+                ))
+            }
+            _ => Ok(()),
+        }
+    }
+
     fn reset(&mut self) {
         self.k = 0;
         self.prev = None;

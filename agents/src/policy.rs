@@ -9,6 +9,11 @@ use crate::nn::{Mlp, Tape};
 use crate::normalize::RunningMeanStd;
 
 pub trait Policy {
+    /// Whether the policy can act on an environment whose reset gave `obs` and `info` (the
+    /// observation indices and info keys it reads exist); the message names what is missing.
+    fn check(&self, _obs: &[f64], _info: &Info) -> Result<(), String> {
+        Ok(())
+    }
     /// Called at every reset (feedback controllers clear their memory here).
     fn reset(&mut self) {}
     /// Writes the action for `obs` into `action` (length = the action space's dimension).
@@ -43,6 +48,29 @@ impl ActorPolicy {
             obs_clip,
             scratch: Scratch::default(),
         }
+    }
+
+    /// Whether a policy read from a file is whole: its network ([`Mlp::check`]), an observation
+    /// normalisation of the network's input size with finite statistics, a positive clip.
+    pub fn validate(&self) -> Result<(), String> {
+        self.net.check()?;
+        if let Some(n) = &self.obs_norm {
+            let dim = self.net.input_dim();
+            if n.mean.len() != dim || n.var.len() != dim {
+                return Err(format!(
+                    "obs_norm has {} means and {} variances for a network of {dim} inputs",
+                    n.mean.len(),
+                    n.var.len()
+                ));
+            }
+            if n.mean.iter().chain(&n.var).any(|v| !v.is_finite()) || n.var.iter().any(|v| *v < 0.0) {
+                return Err("obs_norm holds a value that is not finite, or a negative variance".into());
+            }
+        }
+        if !(self.obs_clip.is_finite() && self.obs_clip > 0.0) {
+            return Err(format!("obs_clip must be positive, got {}", self.obs_clip));
+        }
+        Ok(())
     }
 
     pub fn obs_dim(&self) -> usize {

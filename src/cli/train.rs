@@ -396,6 +396,10 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
     let report: EvalReport = pool
         .install(|| -> Result<EvalReport> {
             let mut env = spec.make(args.level, hgym::env::default_cache_dir())?;
+            let (obs, info) = env.reset(seeds[0])?;
+            policy
+                .check(&obs, &info)
+                .map_err(|m| UsageError(format!("--policy {} on {}: {m}", args.policy, spec.id())))?;
             let reference = uncontrolled_c_d(&mut env, &seeds)?;
             pb.set_position(args.episodes as u64);
             let hash = spec.hash();

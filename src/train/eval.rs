@@ -128,19 +128,29 @@ pub enum PolicyError {
 
 pub fn parse_policy(text: &str) -> Result<NamedPolicy, PolicyError> {
     let (name, arg) = text.split_once('=').map(|(a, b)| (a, Some(b))).unwrap_or((text, None));
-    let num = |s: &str| {
-        s.trim()
-            .parse::<f64>()
-            .map_err(|_| PolicyError::Invalid(format!("'{s}' in --policy {text} is not a number")))
+    let num = |s: &str| match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(PolicyError::Invalid(format!("'{s}' in --policy {text} is not a finite number"))),
     };
     let b = match (name, arg) {
         ("zero", None) => Baseline::Zero,
         ("random", None) => Baseline::Random,
-        ("sine", p) => Baseline::Sine {
-            amplitude: 1.0,
-            period: p.map(num).transpose()?.unwrap_or(20.0),
+        ("sine", p) => match p.map(num).transpose()?.unwrap_or(20.0) {
+            period if period > 0.0 => Baseline::Sine { amplitude: 1.0, period },
+            period => {
+                return Err(PolicyError::Invalid(format!(
+                    "--policy {text}: the period {period} must be positive (in actions)"
+                )))
+            }
         },
-        ("constant", Some(v)) => Baseline::Constant { value: num(v)? },
+        ("constant", Some(v)) => match num(v)? {
+            value if (-1.0..=1.0).contains(&value) => Baseline::Constant { value },
+            value => {
+                return Err(PolicyError::Invalid(format!(
+                    "--policy {text}: {value} is outside the normalised action range [-1, 1]"
+                )))
+            }
+        },
         ("opposition", g) => Baseline::Pd {
             signal: Signal::Info("C_L".into()),
             kp: g.map(num).transpose()?.unwrap_or(1.0),
@@ -185,6 +195,8 @@ pub fn parse_policy(text: &str) -> Result<NamedPolicy, PolicyError> {
             })?;
             let p: ActorPolicy =
                 serde_json::from_str(&body).map_err(|e| PolicyError::Invalid(format!("{} is not a policy file: {e}", file.display())))?;
+            p.validate()
+                .map_err(|e| PolicyError::Invalid(format!("{} is not a whole policy: {e}", file.display())))?;
             return Ok(NamedPolicy::Trained(Box::new(p)));
         }
     };

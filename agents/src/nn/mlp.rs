@@ -113,6 +113,34 @@ impl<T: Scalar> Mlp<T> {
         net
     }
 
+    /// Whether a network read from a file can run: at least an input and an output size, every
+    /// width 1 to 65536, as many parameters as the sizes need (counted without overflow), all
+    /// finite. The message names what is wrong.
+    pub fn check(&self) -> Result<(), String> {
+        if self.sizes.len() < 2 {
+            return Err(format!("sizes {:?}: a network needs an input and an output size", self.sizes));
+        }
+        if let Some(w) = self.sizes.iter().find(|&&w| !(1..=1 << 16).contains(&w)) {
+            return Err(format!("sizes {:?}: a width of {w} (each must be 1 to 65536)", self.sizes));
+        }
+        let n = self
+            .sizes
+            .windows(2)
+            .try_fold(0usize, |n, w| n.checked_add(w[0].checked_mul(w[1])?.checked_add(w[1])?));
+        if n != Some(self.params.len()) {
+            return Err(format!(
+                "sizes {:?} need {} parameters, the file has {}",
+                self.sizes,
+                n.map_or("more than can be counted".to_string(), |n| n.to_string()),
+                self.params.len()
+            ));
+        }
+        if self.params.iter().any(|p| !p.to_f64().is_finite()) {
+            return Err("a parameter is not a finite number".into());
+        }
+        Ok(())
+    }
+
     pub fn layers(&self) -> usize {
         self.sizes.len() - 1
     }
