@@ -61,6 +61,39 @@ fn eval_trajectories_read_back_with_python_and_recover_after_truncation() {
     // full chunks of the episode in progress survive too.
     assert_eq!(r["steps_per_episode"]["0"], 200, "{r}");
     assert_eq!(r["env_id"], "Cylinder_2D_Re100", "the manifest survives: {r}");
+    // The report is truthful: a complete file loses nothing; a file one byte short, or only its
+    // magic bytes, is not complete, and --json's byte counts say how much was whole.
+    let recover_json = |f: &std::path::Path| -> serde_json::Value {
+        let o = hgym(&[
+            "data",
+            "recover",
+            f.to_str().unwrap(),
+            "--out",
+            tmp.path().join("r.mcap").to_str().unwrap(),
+            "--json",
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let whole = recover_json(&file);
+    assert_eq!(whole["complete"], true, "{whole}");
+    assert_eq!(whole["bytes_read"], whole["bytes_total"], "{whole}");
+    assert_eq!(
+        whole["messages"].as_u64(),
+        Some(603 + 600 + 600 + 603),
+        "obs, action, reward, info: {whole}"
+    );
+    let short = tmp.path().join("short.mcap");
+    std::fs::write(&short, &bytes[..bytes.len() - 1]).unwrap();
+    let r = recover_json(&short);
+    assert_eq!(r["complete"], false, "one byte short is not complete: {r}");
+    let magic = tmp.path().join("magic.mcap");
+    std::fs::write(&magic, &bytes[..8]).unwrap();
+    let r = recover_json(&magic);
+    assert_eq!((r["complete"].clone(), r["messages"].clone()), (false.into(), 0.into()), "{r}");
+    let r = recover_json(&cut);
+    assert_eq!(r["complete"], false, "{r}");
+    assert!(r["bytes_read"].as_u64() < r["bytes_total"].as_u64(), "{r}");
     // Not an MCAP file: a clear error, exit 2.
     let junk = tmp.path().join("junk.mcap");
     std::fs::write(&junk, b"hello").unwrap();

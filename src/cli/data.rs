@@ -161,10 +161,16 @@ pub fn run_data(cmd: DataCommand) -> Result<Outcome> {
             r.metadata,
             file.display(),
             out.display(),
-            r.stopped_at
-                .as_ref()
-                .map(|e| format!("\n  lost: everything after the last complete chunk (reading stopped: {e})"))
-                .unwrap_or_else(|| "\n  nothing lost: the file was complete".into())
+            if r.complete {
+                "\n  nothing lost: the file was complete".to_string()
+            } else {
+                format!(
+                    "\n  lost: the file was cut; {} of its {} bytes were whole records, and the messages after the last complete chunk are gone (compressed, so they cannot be counted){}",
+                    r.bytes_read,
+                    r.bytes_total,
+                    r.stopped_at.as_ref().map(|e| format!("; reading stopped: {e}")).unwrap_or_default()
+                )
+            }
         );
     }
     Ok(Outcome::Ok)

@@ -203,13 +203,42 @@ impl Drop for TrajectoryWriter {
 pub struct Recovery {
     pub messages: usize,
     pub metadata: usize,
+    /// Bytes up to the end of the last whole record (what could be read).
     pub bytes_read: usize,
     pub bytes_total: usize,
+    /// Whether the file ended with its footer and magic bytes: then nothing was lost.
+    pub complete: bool,
     pub stopped_at: Option<String>,
 }
 
+/// Walks an MCAP file's records (the magic, then per record an opcode byte, a little-endian u64
+/// length and the content): the offset where the last whole record ends (the file's length if
+/// it is complete), and whether the file ends with a footer record followed by the magic bytes.
+fn scan(buf: &[u8]) -> (usize, bool) {
+    const FOOTER: u8 = 0x02;
+    let m = mcap::MAGIC.len();
+    let mut pos = m.min(buf.len());
+    while pos + 9 <= buf.len() {
+        let op = buf[pos];
+        let mut len = [0u8; 8];
+        len.copy_from_slice(&buf[pos + 1..pos + 9]);
+        let end = (pos as u64 + 9).checked_add(u64::from_le_bytes(len));
+        match end {
+            Some(end) if end <= buf.len() as u64 => pos = end as usize,
+            _ => break,
+        }
+        if op == FOOTER {
+            let complete = buf.len() == pos + m && buf[pos..] == *mcap::MAGIC;
+            return (if complete { buf.len() } else { pos }, complete);
+        }
+    }
+    (pos, false)
+}
+
 /// Copies every message of every complete chunk (and the metadata) of a possibly truncated file
-/// `input` into a new, valid file `output`.
+/// `input` into a new, valid file `output`, and says truthfully whether anything was lost: the
+/// messages of an unfinished chunk are compressed and cannot be counted, so the loss is reported
+/// in bytes.
 pub fn recover(input: &Path, output: &Path) -> Result<Recovery, DataError> {
     use mcap::read::{LinearReader, MessageStream, Options};
     let buf = std::fs::read(input).map_err(DataError::io(input))?;
@@ -254,11 +283,13 @@ pub fn recover(input: &Path, output: &Path) -> Result<Recovery, DataError> {
         w.write(m)?;
     }
     w.finish()?;
+    let (bytes_read, complete) = scan(&buf);
     Ok(Recovery {
         messages: messages.len(),
         metadata: metadata.len(),
-        bytes_read: buf.len(),
+        bytes_read,
         bytes_total: buf.len(),
+        complete: complete && stopped_at.is_none(),
         stopped_at,
     })
 }
