@@ -352,6 +352,60 @@ fn hostile_policies_and_baselines_exit_2_naming_the_problem() {
     }
 }
 
+/// Killed with SIGKILL (no chance to save) after its first round, a run still resumes: the
+/// first checkpoint comes after the first round, not after `checkpoint_seconds`; and every resume
+/// is counted, even one killed at once.
+#[test]
+fn a_run_killed_after_its_first_round_resumes_and_counts_every_resume() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = config(tmp.path());
+    let out = tmp.path().join("runs");
+    let run = out.join("Cylinder_2D_Re100-td3-coarse/seed0");
+    let ck = run.join("checkpoint.bin");
+    let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    // Spawns `args`, waits until the checkpoint is (re)written, and kills the process with -9.
+    let kill_after_checkpoint = |args: &[&str]| {
+        let before = modified(&ck);
+        let mut child = Command::new(env!("CARGO_BIN_EXE_hgym"))
+            .args(args)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let t0 = Instant::now();
+        while modified(&ck) == before || modified(&ck).is_none() {
+            assert!(
+                t0.elapsed().as_secs() < 120,
+                "no checkpoint within 120 s (checkpoint_seconds is 1000)"
+            );
+            assert!(child.try_wait().unwrap().is_none(), "the run ended before it was killed");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        child.kill().unwrap();
+        child.wait().unwrap();
+    };
+    let train = [
+        "train",
+        "--env",
+        "Cylinder_2D_Re100",
+        "--algo",
+        "td3",
+        "--steps",
+        "1600",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    kill_after_checkpoint(&train);
+    kill_after_checkpoint(&["train", "--resume", run.to_str().unwrap()]);
+    let o = hgym(&["train", "--resume", run.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    let manifest: serde_json::Value = serde_json::from_str(&read(&run.join("manifest.json"))).unwrap();
+    assert_eq!(manifest["resumed"], 2, "two resumes, both counted: {manifest}");
+    assert_eq!(manifest["samples"], 1600);
+}
+
 #[test]
 fn bad_training_input_is_named() {
     let o = hgym(&["train", "--env", "Cylindre_2D_Re100", "--steps", "10"]);

@@ -189,7 +189,13 @@ pub fn train(
         )
         .map_err(TrainError::from)
     };
-    let mut last_ckpt = Instant::now();
+    // A resumed run records itself at once (so `resumed` counts every resume, even one killed
+    // before its first round); every run saves after its first round, then every
+    // `checkpoint_seconds`, so a short run killed early can still resume.
+    if resumed > 0 {
+        checkpoint(&*learner, &curve, wall_before)?;
+    }
+    let mut last_ckpt: Option<Instant> = None;
     let mut last_eval = curve
         .iter()
         .rev()
@@ -249,9 +255,9 @@ pub fn train(
             last_eval,
         });
         curve.push(row);
-        if last_ckpt.elapsed().as_secs_f64() >= config.train.checkpoint_seconds {
+        if last_ckpt.is_none_or(|t| t.elapsed().as_secs_f64() >= config.train.checkpoint_seconds) {
             checkpoint(&*learner, &curve, wall_before + started.elapsed().as_secs_f64())?;
-            last_ckpt = Instant::now();
+            last_ckpt = Some(Instant::now());
         }
     }
     let wall = wall_before + started.elapsed().as_secs_f64();
