@@ -131,3 +131,60 @@ fn ctrl_c_during_a_run_leaves_a_valid_trajectory() {
     assert!(steps > 0 && steps < 2000, "{s}");
     assert!(tmp.path().join("Cylinder_2D_Re100-zero-seed0/metrics.json").exists());
 }
+
+/// Found by `tests/fuzz.rs`: a record inside a zstd chunk whose length field claims 2^56 bytes
+/// made the `mcap` crate's message stream reserve it whole and abort the process. Reading and
+/// recovering such a file is an error, never an abort.
+#[test]
+fn a_huge_record_length_inside_a_chunk_is_an_error_not_an_abort() {
+    let mut w = mcap::WriteOptions::new()
+        .compression(None)
+        .create(std::io::Cursor::new(Vec::new()))
+        .unwrap();
+    let meta = [("env_id".to_string(), "Cylinder_2D_Re100".to_string())].into_iter().collect();
+    w.write_metadata(&mcap::records::Metadata {
+        name: "manifest".into(),
+        metadata: meta,
+    })
+    .unwrap();
+    let ch = w.add_channel(0, "/obs", "json", &Default::default()).unwrap();
+    let header = mcap::records::MessageHeader {
+        channel_id: ch,
+        sequence: 0,
+        log_time: 0,
+        publish_time: 0,
+    };
+    w.write_to_known_channel(&header, br#"{"episode":0,"step":0,"obs":[1.0]}"#).unwrap();
+    w.finish().unwrap();
+    let plain = w.into_inner().into_inner();
+    // The chunk (opcode 0x06): times (16), uncompressed size (8), CRC (4), the length of its
+    // compression's name (4; "" here), records length (8), records. Its message record's length is damaged, then the records are
+    // compressed with zstd into a new chunk that replaces it.
+    let at = |i: usize| u64::from_le_bytes(plain[i..i + 8].try_into().unwrap()) as usize;
+    let chunk = (8..plain.len() - 49)
+        .find(|&i| plain[i] == 0x06 && at(i + 9 + 32) == at(i + 9 + 16) && at(i + 9 + 16) > 0)
+        .unwrap();
+    let (len, records_at) = (at(chunk + 1), chunk + 9 + 40);
+    let mut records = plain[records_at..chunk + 9 + len].to_vec();
+    let message = records.iter().position(|&b| b == 0x05).unwrap();
+    records[message + 1..message + 9].copy_from_slice(&(1u64 << 56).to_le_bytes());
+    let packed = zstd::encode_all(&records[..], 3).unwrap();
+    let mut content = plain[chunk + 9..chunk + 9 + 16].to_vec();
+    content.extend((records.len() as u64).to_le_bytes());
+    content.extend(0u32.to_le_bytes());
+    content.extend(4u32.to_le_bytes());
+    content.extend(b"zstd");
+    content.extend((packed.len() as u64).to_le_bytes());
+    content.extend(&packed);
+    let mut bytes = plain[..chunk].to_vec();
+    bytes.push(0x06);
+    bytes.extend((content.len() as u64).to_le_bytes());
+    bytes.extend(content);
+    bytes.extend(&plain[chunk + 9 + len..]);
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("trajectory.mcap");
+    std::fs::write(&file, &bytes).unwrap();
+    assert!(hgym::data::read::read(&file).is_err());
+    let r = hgym::data::trajectory::recover(&file, &tmp.path().join("fixed.mcap")).unwrap();
+    assert!(!r.complete && r.messages == 0, "{r:?}");
+}

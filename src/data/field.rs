@@ -85,16 +85,20 @@ impl Snapshot {
         let data = base64::engine::general_purpose::STANDARD
             .decode(text)
             .map_err(|e| bad(format!("data: {e}")))?;
-        if nx == 0 || stride == 0 || data.len() % (nx * stride) != 0 {
+        let row = nx.checked_mul(stride).filter(|&r| r > 0);
+        let Some(row) = row.filter(|r| data.len().is_multiple_of(*r)) else {
             return Err(bad("data does not fill whole rows".into()));
-        }
-        let ny = data.len() / (nx * stride);
+        };
+        let ny = data.len() / row;
         let listed = v["fields"].as_array().ok_or_else(|| bad("no fields list".into()))?;
+        if listed.len() > stride / 4 {
+            return Err(bad(format!("{} fields cannot fit a {stride}-byte cell", listed.len())));
+        }
         let mut fields = vec![];
         for f in listed {
             let name = f["name"].as_str().ok_or_else(|| bad("a field without a name".into()))?;
             let off = f["offset"].as_u64().ok_or_else(|| bad(format!("field {name} without an offset")))? as usize;
-            if off + 4 > stride {
+            if off.checked_add(4).is_none_or(|end| end > stride) {
                 return Err(bad(format!("field {name} at offset {off} does not fit a {stride}-byte cell")));
             }
             let vals = (0..nx * ny)

@@ -7,7 +7,6 @@ use super::DataError;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use mcap::read::MessageStream;
 use serde_json::Value;
 
 /// One control step of one episode. Step 0 is the reset: it has an observation and info but no
@@ -65,6 +64,24 @@ fn numbers(v: &Value) -> Vec<f64> {
         .unwrap_or_default()
 }
 
+/// Longest record a reader accepts (1 GiB; hgym's writer closes chunks at 768 KiB plus one
+/// message).
+pub const MAX_RECORD: usize = 1 << 30;
+
+/// The messages of an MCAP file in `buf`, in file order, through a reader that bounds every
+/// record's declared length, inside chunks too (by 64 times the file's size, at most
+/// [`MAX_RECORD`]): `mcap::MessageStream` does not bound the records of a decompressed chunk, so a
+/// damaged length there is allocated whole and aborts the process.
+pub fn messages(buf: &[u8], skip_end_magic: bool) -> mcap::io::MessageReader<std::io::Cursor<&[u8]>> {
+    let limit = buf.len().saturating_mul(64).saturating_add(1 << 20).min(MAX_RECORD);
+    mcap::io::MessageReader::new_with_options(
+        std::io::Cursor::new(buf),
+        mcap::sans_io::LinearReaderOptions::default()
+            .with_record_length_limit(limit)
+            .with_skip_end_magic(skip_end_magic),
+    )
+}
+
 /// Reads a complete (or `hgym data recover`-ed) trajectory file.
 pub fn read(path: &Path) -> Result<Trajectory, DataError> {
     let buf = std::fs::read(path).map_err(DataError::io(path))?;
@@ -105,7 +122,7 @@ pub fn read(path: &Path) -> Result<Trajectory, DataError> {
     }
     let mut rows: BTreeMap<(u64, u64), StepRow> = BTreeMap::new();
     let mut fields = vec![];
-    for m in MessageStream::new(&buf).map_err(|e| bad(&e))? {
+    for m in messages(&buf, false) {
         let m = m.map_err(|e| bad(&e))?;
         if m.channel.topic == "/field" {
             fields.push(super::field::Snapshot::decode(&m.data).map_err(|e| bad(&e))?);

@@ -222,8 +222,7 @@ fn scan(buf: &[u8]) -> (usize, bool) {
         let op = buf[pos];
         let mut len = [0u8; 8];
         len.copy_from_slice(&buf[pos + 1..pos + 9]);
-        let end = (pos as u64 + 9).checked_add(u64::from_le_bytes(len));
-        match end {
+        match (pos as u64 + 9).checked_add(u64::from_le_bytes(len)) {
             Some(end) if end <= buf.len() as u64 => pos = end as usize,
             _ => break,
         }
@@ -240,7 +239,7 @@ fn scan(buf: &[u8]) -> (usize, bool) {
 /// messages of an unfinished chunk are compressed and cannot be counted, so the loss is reported
 /// in bytes.
 pub fn recover(input: &Path, output: &Path) -> Result<Recovery, DataError> {
-    use mcap::read::{LinearReader, MessageStream, Options};
+    use mcap::read::{LinearReader, Options};
     let buf = std::fs::read(input).map_err(DataError::io(input))?;
     if !buf.starts_with(mcap::MAGIC) {
         return Err(DataError::Format(format!(
@@ -262,7 +261,7 @@ pub fn recover(input: &Path, output: &Path) -> Result<Recovery, DataError> {
         }
     }
     let mut messages = vec![];
-    for m in MessageStream::new_with_options(&buf, opts)? {
+    for m in super::read::messages(&buf, true) {
         match m {
             Ok(m) => messages.push(m),
             Err(e) => {
