@@ -27,18 +27,10 @@ fn config(dir: &Path) -> PathBuf {
     p
 }
 
-fn read(p: &Path) -> String {
-    std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
-}
-
-#[test]
-fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
-    let tmp = tempfile::tempdir().unwrap();
-    let cfg = config(tmp.path());
-    let cfg = cfg.to_str().unwrap();
-    // Uninterrupted: 4 rounds (1600 samples).
-    let full = tmp.path().join("full");
-    let o = hgym(&[
+/// `hgym train` of TD3 on the cylinder for 1600 samples (4 rounds) with the config `cfg`.
+fn td3_args<'a>(cfg: &'a Path, out: &'a Path) -> [&'a str; 11] {
+    let (cfg, out) = (cfg.to_str().unwrap(), out.to_str().unwrap());
+    [
         "train",
         "--env",
         "Cylinder_2D_Re100",
@@ -49,8 +41,21 @@ fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
         "--config",
         cfg,
         "--out",
-        full.to_str().unwrap(),
-    ]);
+        out,
+    ]
+}
+
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+#[test]
+fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = config(tmp.path());
+    // Uninterrupted: 4 rounds (1600 samples).
+    let full = tmp.path().join("full");
+    let o = hgym(&td3_args(&cfg, &full));
     assert!(o.status.success(), "{}", text(&o));
     let run = full.join("Cylinder_2D_Re100-td3-coarse/seed0");
     for f in [
@@ -81,19 +86,7 @@ fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
     // Interrupted with SIGINT (Ctrl-C) during the run, then resumed.
     let cut = tmp.path().join("cut");
     let mut child = Command::new(env!("CARGO_BIN_EXE_hgym"))
-        .args([
-            "train",
-            "--env",
-            "Cylinder_2D_Re100",
-            "--algo",
-            "td3",
-            "--steps",
-            "1600",
-            "--config",
-            cfg,
-            "--out",
-            cut.to_str().unwrap(),
-        ])
+        .args(td3_args(&cfg, &cut))
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -384,20 +377,7 @@ fn a_run_killed_after_its_first_round_resumes_and_counts_every_resume() {
         child.kill().unwrap();
         child.wait().unwrap();
     };
-    let train = [
-        "train",
-        "--env",
-        "Cylinder_2D_Re100",
-        "--algo",
-        "td3",
-        "--steps",
-        "1600",
-        "--config",
-        cfg.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    kill_after_checkpoint(&train);
+    kill_after_checkpoint(&td3_args(&cfg, &out));
     kill_after_checkpoint(&["train", "--resume", run.to_str().unwrap()]);
     let o = hgym(&["train", "--resume", run.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o));

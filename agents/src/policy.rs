@@ -9,7 +9,7 @@ use crate::nn::{Mlp, Tape};
 use crate::normalize::RunningMeanStd;
 
 pub trait Policy {
-    /// Whether the policy can act on an environment whose reset gave `obs` and `info` (the
+    /// Whether the policy can act on an environment whose step gave `obs` and `info` (the
     /// observation indices and info keys it reads exist); the message names what is missing.
     fn check(&self, _obs: &[f64], _info: &Info) -> Result<(), String> {
         Ok(())

@@ -396,9 +396,11 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
     let report: EvalReport = pool
         .install(|| -> Result<EvalReport> {
             let mut env = spec.make(args.level, hgym::env::default_cache_dir())?;
-            let (obs, info) = env.reset(seeds[0])?;
+            // The first step's info: forces appear there, not at the reset.
+            env.reset(seeds[0])?;
+            let first = env.step(&vec![0.0; spec.act_dim()])?;
             policy
-                .check(&obs, &info)
+                .check(&first.obs, &first.info)
                 .map_err(|m| UsageError(format!("--policy {} on {}: {m}", args.policy, spec.id())))?;
             let reference = uncontrolled_c_d(&mut env, &seeds)?;
             pb.set_position(args.episodes as u64);

@@ -158,15 +158,25 @@ impl PartialEq for Spec {
     }
 }
 
-/// `value` with the TOML overrides `over` deep-merged, read back as `T`.
-pub fn merged<T: Serialize + DeserializeOwned>(value: &T, over: &toml::Table, id: &str) -> Result<T, EnvInputError> {
+/// `value` with `over`'s fields replaced (tables merged key by key), read back as a `T` and
+/// checked by `check`, for `FamilySpec::with_overrides`; errors name the ID.
+pub fn merged<T: FamilySpec + Serialize + DeserializeOwned>(
+    value: &T,
+    over: &toml::Table,
+    id: &str,
+    check: impl Fn(&T) -> Result<(), String>,
+) -> Result<Spec, EnvInputError> {
     let bad = |message: String| EnvInputError::Override {
         id: id.to_string(),
         message,
     };
     let mut base = toml::Table::try_from(value).map_err(|e| bad(format!("the spec cannot be represented as TOML: {e}")))?;
     merge(&mut base, over);
-    toml::Value::Table(base).try_into().map_err(|e: toml::de::Error| bad(e.to_string()))
+    let spec: T = toml::Value::Table(base)
+        .try_into()
+        .map_err(|e: toml::de::Error| bad(e.to_string()))?;
+    check(&spec).map_err(bad)?;
+    Ok(Spec::new(spec))
 }
 
 fn merge(base: &mut toml::Table, over: &toml::Table) {

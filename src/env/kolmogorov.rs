@@ -232,12 +232,7 @@ impl FamilySpec for KolmogorovSpec {
     }
 
     fn with_overrides(&self, over: &toml::Table) -> Result<Spec, EnvInputError> {
-        let spec: KolmogorovSpec = merged(self, over, &self.id)?;
-        spec.check().map_err(|message| EnvInputError::Override {
-            id: self.id.clone(),
-            message,
-        })?;
-        Ok(Spec::new(spec))
+        merged(self, over, &self.id, KolmogorovSpec::check)
     }
 
     fn make(&self, level: Level, _cache: Option<PathBuf>) -> Result<Box<dyn FlowEnv>, EnvError> {

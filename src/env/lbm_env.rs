@@ -686,12 +686,7 @@ impl FamilySpec for EnvSpec {
     }
 
     fn with_overrides(&self, over: &toml::Table) -> Result<Spec, EnvInputError> {
-        let spec: EnvSpec = merged(self, over, &self.id)?;
-        spec.check().map_err(|message| EnvInputError::Override {
-            id: self.id.clone(),
-            message,
-        })?;
-        Ok(Spec::new(spec))
+        merged(self, over, &self.id, EnvSpec::check)
     }
 
     fn make(&self, level: Level, cache: Option<PathBuf>) -> Result<Box<dyn FlowEnv>, EnvError> {
