@@ -162,11 +162,12 @@ proptest! {
         }
     }
 
-    /// Policy files: a policy that is accepted must act without a panic.
+    /// Policy files (a PPO and a TD3 actor of the cylinder, a GPPO actor of the Kolmogorov
+    /// flow): a policy that is accepted must act without a panic.
     #[test]
-    fn policy_loader_never_panics(e in edits()) {
-        let good = std::fs::read(common::repo().join("results/train/Cylinder_2D_Re100-ppo-coarse/seed1/policy.json")).unwrap();
-        let text = apply(&good, &e);
+    fn policy_loader_never_panics(pick in any::<usize>(), e in edits()) {
+        let corpus = policies();
+        let text = apply(&corpus[pick % corpus.len()], &e);
         if let Ok(mut p) = serde_json::from_slice::<hgym_agents::policy::ActorPolicy>(&text) {
             if p.validate().is_ok() {
                 use hgym_agents::policy::Policy;
@@ -190,6 +191,21 @@ proptest! {
             prop_assert!(!r.complete || r.bytes_read == r.bytes_total);
         }
     }
+}
+
+/// The committed policies the policy target mutates, read once.
+fn policies() -> &'static [Vec<u8>] {
+    static BYTES: std::sync::OnceLock<Vec<Vec<u8>>> = std::sync::OnceLock::new();
+    BYTES.get_or_init(|| {
+        [
+            "results/train/Cylinder_2D_Re100-ppo-coarse/seed1/policy.json",
+            "results/train/Cylinder_2D_Re100-td3-coarse/seed0/policy.json",
+            "results/compare/kolmogorov_gppo/gppo/seed0/policy.json",
+        ]
+        .iter()
+        .map(|p| std::fs::read(common::repo().join(p)).unwrap())
+        .collect()
+    })
 }
 
 /// `hgym envs show` output's fields as the body of an `[env]` table (the comment line dropped).

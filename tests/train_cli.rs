@@ -258,6 +258,14 @@ fn hostile_overrides_and_arguments_exit_2_at_once() {
             ],
             "--eval-seed",
         ),
+        (
+            &["eval", "--policy", "zero", "--env", "Cylinder_2D_Re100", "--episodes", "0"],
+            "--episodes",
+        ),
+        (
+            &["eval", "--policy", "zero", "--env", "Cylinder_2D_Re100", "--episodes", "100001"],
+            "--episodes",
+        ),
     ];
     for (a, words) in args {
         let o = hgym(a);

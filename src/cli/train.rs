@@ -73,8 +73,9 @@ pub struct EvalArgs {
     /// Environment ID; a policy trained on another flow works if the observation and action sizes match.
     #[arg(long)]
     env: String,
-    #[arg(long, default_value_t = 3)]
-    episodes: usize,
+    /// Episodes to evaluate (1 to 100000).
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    episodes: u64,
     #[arg(long = "res", value_enum, default_value_t = Level::Coarse)]
     level: Level,
     /// Episode k starts from reset(eval_seed + k); the default matches training's evaluation.
@@ -330,9 +331,6 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
 }
 
 pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
-    if args.episodes == 0 {
-        return Err(UsageError("--episodes must be at least 1".into()).into());
-    }
     let config = load_config(args.config.as_deref())?;
     let spec = resolve_spec(&args.env, &config).map_err(train_error)?;
     let named = parse_policy(&args.policy)?;
@@ -358,7 +356,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
     };
     let (pool, threads) = thread_pool(args.threads)?;
     let started = std::time::Instant::now();
-    if args.eval_seed.checked_add(args.episodes as u64).is_none() {
+    if args.eval_seed.checked_add(args.episodes).is_none() {
         return Err(UsageError(format!(
             "--eval-seed {} + --episodes {} passes the largest seed ({}): give a smaller --eval-seed",
             args.eval_seed,
@@ -367,8 +365,8 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
         ))
         .into());
     }
-    let seeds: Vec<u64> = (0..args.episodes as u64).map(|k| args.eval_seed + k).collect();
-    let pb = progress_bar(2 * args.episodes as u64, spec.id());
+    let seeds: Vec<u64> = (0..args.episodes).map(|k| args.eval_seed + k).collect();
+    let pb = progress_bar(2 * args.episodes, spec.id());
     let slug: String = args
         .policy
         .chars()
@@ -403,7 +401,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
                 .check(&first.obs, &first.info)
                 .map_err(|m| UsageError(format!("--policy {} on {}: {m}", args.policy, spec.id())))?;
             let reference = uncontrolled_c_d(&mut env, &seeds)?;
-            pb.set_position(args.episodes as u64);
+            pb.set_position(args.episodes);
             let hash = spec.hash();
             Ok(evaluate(
                 &mut env,
@@ -415,7 +413,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
                 &seeds,
                 &reference,
                 trajectory.as_mut(),
-                &mut |k| pb.set_position((args.episodes + k) as u64),
+                &mut |k| pb.set_position(args.episodes + k as u64),
             )?)
         })
         .with_context(|| format!("evaluating {} on {}", args.policy, spec.id()))?;
