@@ -51,7 +51,7 @@ pub enum HubError {
     Auth { status: u16, what: String, message: String },
     #[error("the Hub answered {status} while {what}: {message}")]
     Http { status: u16, what: String, message: String },
-    #[error("the Hub's answer while {what} is not what its API returns ({problem}); nothing was committed by this step. The answer began: {body}")]
+    #[error("the Hub's answer while {what} is not what its API returns ({problem}), so the push is not confirmed; check the repository on the Hub before pushing again. The answer began: {body}")]
     Reply { what: String, problem: String, body: String },
     #[error("the server redirected to {to} while {what}: not followed, because it is not {origin} (hgym follows redirects only within one origin, so the token never leaves the endpoint)")]
     Redirect { what: String, origin: String, to: String },
