@@ -210,6 +210,16 @@ fn hostile_overrides_and_arguments_exit_2_at_once() {
         ("Kolmogorov_2D_Re40", "control_interval = nan", "control_interval"),
         ("Kolmogorov_2D_Re40", "probes_per_side = 7", "probes_per_side"),
         ("Kolmogorov_2D_Re40", "control_wavenumbers = [0]", "control_wavenumbers"),
+        (
+            "NACA0012_2D_Re100_AoA20",
+            "[[env.bodies]]\nshape = \"naca\"\ndigits = \"0012\"\nchord = 1.0\nleading_edge = [6.5, 0.0]\naoa_deg = nan",
+            "aoa_deg",
+        ),
+        (
+            "NACA0012_2D_Re100_AoA20",
+            "[[env.bodies]]\nshape = \"naca\"\ndigits = \"0000\"\nchord = 1.0\nleading_edge = [6.5, 0.0]\naoa_deg = 20.0",
+            "thickness",
+        ),
     ];
     for (id, line, words) in overrides {
         std::fs::write(&cfg, format!("[env]\n{line}\n")).unwrap();
