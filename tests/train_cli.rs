@@ -297,7 +297,8 @@ fn hostile_policies_and_baselines_exit_2_naming_the_problem() {
     let tmp = tempfile::tempdir().unwrap();
     let good = common::repo().join("results/train/Cylinder_2D_Re100-ppo-coarse/seed1/policy.json");
     let base: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(good).unwrap()).unwrap();
-    let edits: Vec<(&str, Box<dyn Fn(&mut serde_json::Value)>, &str)> = vec![
+    type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+    let edits: Vec<(&str, Edit, &str)> = vec![
         (
             "empty_sizes",
             Box::new(|p| p["net"]["sizes"] = serde_json::json!([])),

@@ -115,7 +115,7 @@ pub fn run(cmd: BenchCommand) -> Result<Outcome> {
             if json {
                 println!("{}", serde_json::json!({"threads": n, "copy_gbs": gbs}));
             } else {
-                println!("STREAM copy, {n} thread(s), 2 x {} MB: {gbs:.2} GB/s", values * 4 >> 20);
+                println!("STREAM copy, {n} thread(s), 2 x {} MB: {gbs:.2} GB/s", (values * 4) >> 20);
             }
             Ok(Outcome::Ok)
         }
