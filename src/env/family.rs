@@ -76,7 +76,7 @@ pub trait FamilySpec: Any + Send + Sync + std::fmt::Debug {
 
 /// The episode fields every family shares, checked: a control interval in (0, 1000] time units,
 /// 1 to 10^7 actions per episode, a spin-up in [0, 10^5].
-pub fn check_episode(control_interval: f64, episode_actions: usize, spin_up: f64) -> Result<(), String> {
+pub(crate) fn check_episode(control_interval: f64, episode_actions: usize, spin_up: f64) -> Result<(), String> {
     if !(control_interval.is_finite() && control_interval > 0.0 && control_interval <= 1e3) {
         return Err(format!("control_interval must be a time in (0, 1000], got {control_interval}"));
     }

@@ -91,7 +91,7 @@ pub struct KolmogorovSpec {
 impl KolmogorovSpec {
     /// The checks [`KolmogorovEnv::new`] would otherwise meet late: positive finite Re, step and
     /// amplitude; control wavenumbers 1 to 7; probes that sit on every level's grid; the episode.
-    pub fn check(&self) -> Result<(), String> {
+    pub(crate) fn check(&self) -> Result<(), String> {
         super::family::check_episode(self.control_interval, self.episode_actions, self.spin_up)?;
         for (key, v) in [
             ("reynolds", self.reynolds),
@@ -355,12 +355,7 @@ impl KolmogorovEnv {
             dt: spec.dt(level),
             control_wavenumbers: spec.control_wavenumbers.clone(),
         };
-        if spec.probes_per_side == 0 || !n.is_multiple_of(spec.probes_per_side) {
-            return Err(EnvError::Backend(format!(
-                "{}: {} probes per side do not sit on the {n}-point grid",
-                spec.id, spec.probes_per_side
-            )));
-        }
+        spec.check().map_err(|m| EnvError::Backend(format!("{}: {m}", spec.id)))?;
         let solver = Kolmogorov::new(cfg).map_err(backend)?;
         let substeps = (spec.control_interval / spec.dt(level)).round().max(1.0) as usize;
         let st = &spec.statistics;

@@ -225,7 +225,7 @@ impl EnvSpec {
 
     /// Every field a `--config` can change, checked before anything is built: the flow (as
     /// validation checks it), the episode, and probes (at least one, at finite positions).
-    pub fn check(&self) -> Result<(), String> {
+    pub(crate) fn check(&self) -> Result<(), String> {
         self.flow_setup().check().map_err(|e| e.to_string())?;
         super::family::check_episode(self.control_interval, self.episode_actions, self.spin_up)?;
         if self.probes.is_empty() {

@@ -53,7 +53,7 @@ impl GeometrySpec {
     /// Finite coordinates, positive lengths, an angle of attack within +-90 degrees, a NACA code
     /// with a thickness, a stenosis that leaves the channel open (severity in [0, 0.5)); the
     /// message names the key.
-    pub fn check(&self) -> Result<(), String> {
+    pub(crate) fn check(&self) -> Result<(), String> {
         let finite = |key: &str, p: &[f64; 2]| {
             if p.iter().all(|v| v.is_finite()) {
                 Ok(())

@@ -36,16 +36,16 @@ pub use plan::{FlowPlan, RefinementPlan, RefinementSpec, MAX_LATTICE_SPEED, MAX_
 /// `[a, b]` and nothing else: TOML readers fill a fixed-size array from the front and drop what
 /// follows, so `x = [0, 60, 90]` would silently lose its third number.
 pub fn pair<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
-    let v = Vec::<f64>::deserialize(d)?;
-    <[f64; 2]>::try_from(v.as_slice()).map_err(|_| serde::de::Error::invalid_length(v.len(), &"two numbers [a, b]"))
+    exactly_two(&Vec::<f64>::deserialize(d)?)
+}
+
+fn exactly_two<E: serde::de::Error>(v: &[f64]) -> Result<[f64; 2], E> {
+    <[f64; 2]>::try_from(v).map_err(|_| E::invalid_length(v.len(), &"two numbers [a, b]"))
 }
 
 /// A list of `[a, b]` pairs, each checked as [`pair`] checks one.
 pub fn pairs<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
-    let v = Vec::<Vec<f64>>::deserialize(d)?;
-    v.iter()
-        .map(|p| <[f64; 2]>::try_from(p.as_slice()).map_err(|_| serde::de::Error::invalid_length(p.len(), &"two numbers [a, b]")))
-        .collect()
+    Vec::<Vec<f64>>::deserialize(d)?.iter().map(|p| exactly_two(p)).collect()
 }
 
 /// A flow that cannot be set up. `field` names the set-up's field (as [`FlowSetup`] calls it);
