@@ -33,8 +33,9 @@ step bench-envs       "$HGYM" bench envs --quick
 for algo in ppo ddpg td3 gppo; do
   step "train-$algo" "$HGYM" train --env Kolmogorov_2D_Re40 --algo "$algo" --steps 2000 --out "$OUT/train"
 done
-# The fuzz targets of hostile input (tests/fuzz.rs): 10^4 inputs each (make test runs 64).
-step fuzz env PROPTEST_CASES=10000 cargo test --release --locked --test fuzz
+# The fuzz targets of hostile input (tests/fuzz.rs, and the Hub replies in tests/hub_push.rs):
+# 10^4 inputs each (make test runs 64, the Hub 512).
+step fuzz env PROPTEST_CASES=10000 cargo test --release --locked --test fuzz --test hub_push
 step leaderboard "$HGYM" leaderboard
 total=$(( $(date +%s) - start ))
 {

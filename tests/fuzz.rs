@@ -3,124 +3,23 @@
 //! loader (and one action of a policy it accepts), and the MCAP reader and `recover`. Each target
 //! mutates a corpus of the repository's own files (bundled cases, the default config, committed
 //! policies, a trajectory written here) and asserts that no input panics: every one is either
-//! accepted or refused with an error.
+//! accepted or refused with an error. The fifth target, the Hub's replies, lives beside the
+//! Hub stand-in in `tests/hub_push.rs`.
 //!
 //! Why proptest, not `cargo fuzz`: cargo-fuzz needs a nightly toolchain and libFuzzer, and this
 //! project builds with the one stable toolchain its machines have; proptest runs inside `cargo
-//! test`, shrinks a failure to a small input and records it under `proptest-regressions/`, where
-//! it is replayed by every later run (each crash found becomes a regression test by being
-//! committed there). `make test` runs 64 inputs per target (`PROPTEST_CASES` unset); `make
+//! test` and shrinks a failure to a small input, which becomes a regression test beside the
+//! reader's other tests (the MCAP chunk abort: `tests/mcap_files.rs`). `make test` runs 64 inputs per target (`PROPTEST_CASES` unset); `make
 //! nightly` runs 10^4 (`PROPTEST_CASES=10000`).
 
 mod common;
+#[path = "common/mutate.rs"]
+mod mutate;
 
 use std::path::PathBuf;
 
+use mutate::{apply, cases, edits};
 use proptest::prelude::*;
-
-/// Inputs per target: `PROPTEST_CASES`, else 64 (seconds in `make test`).
-fn cases() -> u32 {
-    std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(64)
-}
-
-/// Values that have broken readers before: overflowing, not-a-number, empty, negative, huge.
-const TOKENS: &[&str] = &[
-    "nan",
-    "inf",
-    "-inf",
-    "1e300",
-    "1e-300",
-    "-1",
-    "0",
-    "0.0",
-    "4294967296",
-    "18446744073709551615",
-    "[]",
-    "[1.0, 2.0, 3.0]",
-    "\"\"",
-    "\"0000\"",
-    "\"../../x\"",
-    "true",
-    "{}",
-    "-5.0",
-    "1e9",
-];
-
-/// One edit of a text: replace the `k`-th number (or quoted string) with a token, cut the text
-/// short, or delete, duplicate or flip a byte.
-#[derive(Clone, Debug)]
-enum Edit {
-    Token { k: usize, token: usize },
-    Truncate(usize),
-    Delete(usize),
-    Duplicate(usize),
-    Flip(usize, u8),
-}
-
-fn edits() -> impl Strategy<Value = Vec<Edit>> {
-    let one = prop_oneof![
-        4 => (any::<usize>(), 0..TOKENS.len()).prop_map(|(k, token)| Edit::Token { k, token }),
-        1 => any::<usize>().prop_map(Edit::Truncate),
-        1 => any::<usize>().prop_map(Edit::Delete),
-        1 => any::<usize>().prop_map(Edit::Duplicate),
-        2 => (any::<usize>(), any::<u8>()).prop_map(|(i, b)| Edit::Flip(i, b)),
-    ];
-    prop::collection::vec(one, 1..4)
-}
-
-/// The byte ranges of number literals and quoted strings in `s`.
-fn literals(s: &[u8]) -> Vec<(usize, usize)> {
-    let mut out = vec![];
-    let mut i = 0;
-    while i < s.len() {
-        let start = i;
-        if s[i] == b'"' {
-            i += 1;
-            while i < s.len() && s[i] != b'"' {
-                i += 1;
-            }
-            out.push((start, (i + 1).min(s.len())));
-        } else if s[i].is_ascii_digit() || (s[i] == b'-' && s.get(i + 1).is_some_and(u8::is_ascii_digit)) {
-            i += 1;
-            while i < s.len() && (s[i].is_ascii_alphanumeric() || b".+-".contains(&s[i])) {
-                i += 1;
-            }
-            out.push((start, i));
-            continue;
-        }
-        i += 1;
-    }
-    out
-}
-
-fn apply(base: &[u8], edits: &[Edit]) -> Vec<u8> {
-    let mut s = base.to_vec();
-    for e in edits {
-        if s.is_empty() {
-            break;
-        }
-        let n = s.len();
-        match *e {
-            Edit::Token { k, token } => {
-                let lits = literals(&s);
-                if let Some(&(a, b)) = lits.get(k % lits.len().max(1)) {
-                    s.splice(a..b, TOKENS[token].bytes());
-                }
-            }
-            Edit::Truncate(i) => s.truncate(i % n),
-            Edit::Delete(i) => {
-                s.remove(i % n);
-            }
-            Edit::Duplicate(i) => {
-                let (a, b) = (i % n, (i % n + 64).min(n));
-                let copy = s[a..b].to_vec();
-                s.splice(a..a, copy);
-            }
-            Edit::Flip(i, b) => s[i % n] ^= b.max(1),
-        }
-    }
-    s
-}
 
 fn files(dir: &str, ext: &str) -> Vec<Vec<u8>> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(common::repo().join(dir))
@@ -141,7 +40,7 @@ proptest! {
     #[test]
     fn case_reader_never_panics(pick in any::<usize>(), e in edits()) {
         let corpus = files("benchmarks/validation", "toml");
-        let text = apply(&corpus[pick % corpus.len()], &e);
+        let text = apply(&corpus[pick % corpus.len()], &e, &[]);
         if let Ok(c) = hgym::validate::LoadedCase::parse(&String::from_utf8_lossy(&text), "fuzz.toml") {
             for level in [hgym::flow::Level::Coarse, hgym::flow::Level::Default, hgym::flow::Level::Fine] {
                 let _ = hgym::validate::run::Plan::new(&c, level);
@@ -154,7 +53,7 @@ proptest! {
     fn config_reader_never_panics(id in prop::sample::select(vec!["Cylinder_2D_Re100", "Pinball_2D_Re100", "Kolmogorov_2D_Re40"]), e in edits()) {
         let spec = hgym::env::lookup(id).unwrap();
         let base = format!("{}[env]\n{}", hgym::train::config::TrainConfig::default().to_toml(), env_table(&spec.to_toml()));
-        let text = apply(base.as_bytes(), &e);
+        let text = apply(base.as_bytes(), &e, &[]);
         if let Ok(c) = hgym::train::config::TrainConfig::parse(&String::from_utf8_lossy(&text), "fuzz.toml") {
             if let Ok(s) = hgym::train::resolve_spec(id, &c) {
                 let _ = (s.obs_dim(), s.act_dim(), s.hash());
@@ -167,7 +66,7 @@ proptest! {
     #[test]
     fn policy_loader_never_panics(pick in any::<usize>(), e in edits()) {
         let corpus = policies();
-        let text = apply(&corpus[pick % corpus.len()], &e);
+        let text = apply(&corpus[pick % corpus.len()], &e, &[]);
         if let Ok(mut p) = serde_json::from_slice::<hgym_agents::policy::ActorPolicy>(&text) {
             if p.validate().is_ok() {
                 use hgym_agents::policy::Policy;
@@ -182,7 +81,7 @@ proptest! {
     #[test]
     fn mcap_reader_and_recover_never_panic(e in edits()) {
         let dir = tempfile::tempdir().unwrap();
-        let bytes = apply(&trajectory(), &e);
+        let bytes = apply(&trajectory(), &e, &[]);
         let input = dir.path().join("in.mcap");
         std::fs::write(&input, &bytes).unwrap();
         let _ = hgym::data::read::read(&input);

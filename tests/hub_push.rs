@@ -13,6 +13,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::{Arc, Mutex};
 
+#[path = "common/mutate.rs"]
+mod mutate;
+
 use base64::Engine;
 use sha2::{Digest, Sha256};
 
@@ -59,6 +62,23 @@ struct Hub {
     /// The other origin's address (`http://127.0.0.1:OTHER`).
     foreign: String,
     put_failed_once: bool,
+    /// No injected 429 or 503 (the fuzz target's baseline: every reply but the mutated one is right).
+    steady: bool,
+    /// The fuzz target's change to one reply.
+    mutation: Option<Mutation>,
+}
+
+/// A change to the `nth` reply (0-based, in the order requests arrive): its addresses moved to
+/// the other origin (`reroute`), its body mutated (with `tokens` besides the usual ones), its
+/// status and its extra header line replaced.
+#[derive(Clone, Debug)]
+struct Mutation {
+    nth: usize,
+    reroute: bool,
+    edits: Vec<mutate::Edit>,
+    tokens: Vec<String>,
+    status: Option<u16>,
+    header: Option<String>,
 }
 
 fn respond(s: &mut TcpStream, status: u16, extra: &str, body: &str) {
@@ -108,24 +128,43 @@ fn handle(mut s: TcpStream, hub: &Arc<Mutex<Hub>>, port: u16) {
     let Some(req) = read_request(&mut s) else { return };
     let mut h = hub.lock().unwrap();
     h.requests.push(req.clone());
+    let (mut status, mut extra, mut body) = answer(&req, &mut h, port);
+    if let Some(m) = h.mutation.as_ref().filter(|m| m.nth + 1 == h.requests.len()) {
+        if m.reroute {
+            body = body.replace(&format!("http://127.0.0.1:{port}"), &h.foreign);
+        }
+        body = String::from_utf8_lossy(&mutate::apply(body.as_bytes(), &m.edits, &m.tokens)).into_owned();
+        status = m.status.unwrap_or(status);
+        extra = m.header.clone().map_or(extra, |hd| format!("{hd}\r\n"));
+    }
+    drop(h);
+    respond(&mut s, status, &extra, &body)
+}
+
+fn reply(status: u16, extra: impl Into<String>, body: impl Into<String>) -> (u16, String, String) {
+    (status, extra.into(), body.into())
+}
+
+/// The Hub's answer to `req`: status, extra header lines, body.
+fn answer(req: &Request, h: &mut Hub, port: u16) -> (u16, String, String) {
     let json = |b: &[u8]| serde_json::from_slice::<serde_json::Value>(b).unwrap_or_default();
     let hub_call = req.path.starts_with("/api/") || req.path.contains(".git/");
     if hub_call && req.auth.as_deref() != Some(&format!("Bearer {TOKEN}")) {
-        return respond(&mut s, 401, "", r#"{"error":"Invalid credentials in Authorization header"}"#);
+        return (401, "".into(), r#"{"error":"Invalid credentials in Authorization header"}"#.into());
     }
     let creates = h.requests.iter().filter(|r| r.path == "/api/repos/create").count();
     let m = h.misbehave;
     match (req.method.as_str(), req.path.as_str()) {
         ("POST", "/api/repos/create") if m == Misbehave::RedirectAway => {
-            respond(&mut s, 307, &format!("Location: {}/api/repos/create\r\n", h.foreign), "")
+            reply(307, format!("Location: {}/api/repos/create\r\n", h.foreign), "")
         }
-        ("POST", "/api/repos/create") if creates == 1 => {
+        ("POST", "/api/repos/create") if creates == 1 && !h.steady => {
             let after = if m == Misbehave::RetryAfterNaN { "NaN" } else { "0" };
-            respond(&mut s, 429, &format!("Retry-After: {after}\r\n"), r#"{"error":"slow down"}"#)
+            reply(429, format!("Retry-After: {after}\r\n"), r#"{"error":"slow down"}"#)
         }
         ("POST", "/api/repos/create") => {
             h.created.push(json(&req.body));
-            respond(&mut s, 200, "", r#"{"url":"http://hub/datasets/alice/flows"}"#)
+            reply(200, "", r#"{"url":"http://hub/datasets/alice/flows"}"#)
         }
         ("POST", "/api/datasets/alice/flows/preupload/main") => {
             let files: Vec<serde_json::Value> = json(&req.body)["files"]
@@ -142,7 +181,7 @@ fn handle(mut s: TcpStream, hub: &Arc<Mutex<Hub>>, port: u16) {
                     serde_json::json!({"path": p, "uploadMode": mode, "shouldIgnore": false})
                 })
                 .collect();
-            respond(&mut s, 200, "", &serde_json::json!({ "files": files }).to_string())
+            reply(200, "", serde_json::json!({ "files": files }).to_string())
         }
         ("POST", "/datasets/alice/flows.git/info/lfs/objects/batch") => {
             let objects: Vec<serde_json::Value> = json(&req.body)["objects"]
@@ -160,34 +199,36 @@ fn handle(mut s: TcpStream, hub: &Arc<Mutex<Hub>>, port: u16) {
                         "verify": {"href": verify, "header": {}}}})
                 })
                 .collect();
-            respond(&mut s, 200, "", &serde_json::json!({ "objects": objects }).to_string())
+            reply(200, "", serde_json::json!({ "objects": objects }).to_string())
         }
         ("PUT", p) if p.starts_with("/lfs/upload/") => {
-            if !h.put_failed_once {
+            if !h.put_failed_once && !h.steady {
                 h.put_failed_once = true;
-                return respond(&mut s, 503, "", "busy");
+                return reply(503, "", "busy");
             }
             let oid = p.trim_start_matches("/lfs/upload/").to_string();
-            assert_eq!(format!("{:x}", Sha256::digest(&req.body)), oid, "uploaded bytes match their oid");
+            if format!("{:x}", Sha256::digest(&req.body)) != oid {
+                return reply(400, "", r#"{"error":"the bytes do not match their oid"}"#);
+            }
             h.lfs.insert(oid, req.body.clone());
-            respond(&mut s, 200, "", "")
+            reply(200, "", "")
         }
-        ("POST", "/lfs/verify") => respond(&mut s, 200, "", "{}"),
+        ("POST", "/lfs/verify") => reply(200, "", "{}"),
         ("POST", "/api/datasets/alice/flows/commit/main") => {
             match m {
-                Misbehave::CommitFails => return respond(&mut s, 500, "", r#"{"error":"internal"}"#),
-                Misbehave::CommitNotJson => return respond(&mut s, 200, "", "<html>gateway</html>"),
-                Misbehave::CommitEmpty => return respond(&mut s, 200, "", ""),
+                Misbehave::CommitFails => return reply(500, "", r#"{"error":"internal"}"#),
+                Misbehave::CommitNotJson => return reply(200, "", "<html>gateway</html>"),
+                Misbehave::CommitEmpty => return reply(200, "", ""),
                 Misbehave::EchoToken => {
                     let echo = format!("bad header {}", req.auth.clone().unwrap_or_default());
-                    return respond(&mut s, 500, "", &serde_json::json!({ "error": echo }).to_string());
+                    return reply(500, "", serde_json::json!({ "error": echo }).to_string());
                 }
                 _ => {}
             }
             h.commits.push(String::from_utf8(req.body.clone()).unwrap());
-            respond(&mut s, 200, "", r#"{"commitOid":"c0ffee","commitUrl":"http://hub/c0ffee"}"#)
+            reply(200, "", r#"{"commitOid":"c0ffee","commitUrl":"http://hub/c0ffee"}"#)
         }
-        _ => respond(&mut s, 404, "", r#"{"error":"no such endpoint"}"#),
+        _ => reply(404, "", r#"{"error":"no such endpoint"}"#),
     }
 }
 
@@ -505,4 +546,96 @@ fn a_misbehaving_hub_gets_clear_errors_and_never_the_token() {
             path.display()
         );
     }
+}
+
+/// Fuzz target: one reply of an otherwise correct Hub is mutated (its addresses moved to another
+/// origin, its JSON edited with values that break readers, the token itself and addresses on
+/// another origin among them; its status
+/// and one header replaced: redirects, 429 with `Retry-After` garbage, 5xx). `push` must return,
+/// never panic; report success only after it sent the commit; keep the token out of its
+/// messages and away from the other origin. `PROPTEST_CASES` replies, at least 512 (`make
+/// test`; 10^4 in `make nightly`).
+#[test]
+fn fuzz_push_survives_any_mutated_reply() {
+    use proptest::prelude::*;
+    use proptest::test_runner::{Config, TestRunner};
+
+    let tmp = tempfile::tempdir().unwrap();
+    let ds = tmp.path().join("ds");
+    std::fs::create_dir_all(ds.join("data")).unwrap();
+    std::fs::write(ds.join("README.md"), "# flows\n").unwrap();
+    std::fs::write(ds.join("data/train-00000.parquet"), b"PAR1 not really parquet PAR1").unwrap();
+    let (endpoint, hub, foreign, seen) = serve_pair(Misbehave::None);
+    let cfg = hgym::data::hub::HubConfig::new(&endpoint, hgym::data::hub::Token::new(TOKEN), 0, std::time::Duration::from_secs(5)).unwrap();
+    let tokens = vec![
+        format!("\"{TOKEN}\""),
+        format!("\"{foreign}/lfs/verify\""),
+        format!("\"{foreign}/lfs/upload/x\""),
+        "\"lfs\"".to_string(),
+        "\"regular\"".to_string(),
+        r#"{"chunk_size": "1"}"#.to_string(),
+    ];
+    let statuses = prop::option::weighted(
+        0.3,
+        prop::sample::select(vec![200u16, 201, 204, 301, 302, 307, 308, 400, 401, 403, 404, 409, 429, 500, 503]),
+    );
+    let headers = prop::option::weighted(
+        0.3,
+        prop::sample::select(vec![
+            format!("Location: {foreign}/api/repos/create"),
+            "Location: /lfs/verify".to_string(),
+            "Retry-After: NaN".to_string(),
+            "Retry-After: 99999999999999999999".to_string(),
+            "Content-Type: text/html".to_string(),
+        ]),
+    );
+    let edits = prop_oneof![Just(vec![]), mutate::edits()];
+    let strategy = (0..6usize, any::<bool>(), edits, statuses, headers);
+    let (confirmed, refused) = (std::cell::Cell::new(0), std::cell::Cell::new(0));
+    let mut runner = TestRunner::new(Config {
+        // At least 512: a push takes milliseconds, and a leak needs one reply of six rerouted.
+        cases: mutate::cases().max(512),
+        failure_persistence: None,
+        ..Config::default()
+    });
+    runner
+        .run(&strategy, |(nth, reroute, edits, status, header)| {
+            *hub.lock().unwrap() = Hub {
+                steady: true,
+                foreign: foreign.clone(),
+                mutation: Some(Mutation {
+                    nth,
+                    reroute,
+                    edits,
+                    tokens: tokens.clone(),
+                    status,
+                    header,
+                }),
+                ..Hub::default()
+            };
+            seen.lock().unwrap().clear();
+            let result = hgym::data::hub::push(&ds, "alice/flows", false, "fuzz", &cfg, &mut |_| {});
+            let committed = hub.lock().unwrap().requests.iter().any(|r| r.path.ends_with("/commit/main"));
+            match &result {
+                Ok(report) => {
+                    confirmed.set(confirmed.get() + 1);
+                    prop_assert!(committed && !report.commit.is_empty(), "success without a commit: {report:?}")
+                }
+                Err(e) => {
+                    refused.set(refused.get() + 1);
+                    let m = e.to_string();
+                    prop_assert!(!m.contains(TOKEN) && !m.contains("SECRET_4711"), "the token in a message: {m}");
+                }
+            }
+            for r in seen.lock().unwrap().iter() {
+                prop_assert!(
+                    r.auth.as_deref().is_none_or(|a| !a.contains(TOKEN)),
+                    "the token reached the other origin: {r:?}"
+                );
+            }
+            Ok(())
+        })
+        .unwrap();
+    println!("{} pushes confirmed, {} refused", confirmed.get(), refused.get());
+    assert!(confirmed.get() > 0, "no push succeeded: the stand-in's unmutated replies are wrong");
 }

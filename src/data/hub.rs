@@ -33,6 +33,13 @@ use url::Origin;
 #[derive(Clone)]
 pub struct Token(String);
 
+impl Token {
+    /// A token given by the caller (the CLI reads it with [`token_from_env`]).
+    pub fn new(token: impl Into<String>) -> Token {
+        Token(token.into())
+    }
+}
+
 impl std::fmt::Debug for Token {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str("Token(<hidden>)")
