@@ -187,15 +187,13 @@ pub fn check_repo(repo: &str) -> Result<(&str, &str), HubError> {
     }
 }
 
-/// `text` (a server's words) for a message: at most 300 characters, with the token and anything
-/// shaped like a Hugging Face token (`hf_` and 8 or more letters or digits) replaced by `hf_***`.
+/// `text` (a server's words) for a message: at most 300 characters, with the token, any piece
+/// of it of 8 or more characters, and anything shaped like a Hugging Face token (`hf_` and 8 or
+/// more letters or digits) replaced by `hf_***`.
 pub fn redact(text: &str, token: &Token) -> String {
-    let text: String = text.chars().take(300).collect();
-    let text = if token.0.is_empty() {
-        text
-    } else {
-        text.replace(&token.0, "hf_***")
-    };
+    // Mask a bounded head (bodies can be large); the 300 characters shown lie inside it.
+    let head: String = text.chars().take(4096).collect();
+    let text = mask_fragments(&head, token.0.as_bytes());
     let mut out = String::with_capacity(text.len());
     let mut rest = text.as_str();
     while let Some(i) = rest.find("hf_") {
@@ -206,6 +204,32 @@ pub fn redact(text: &str, token: &Token) -> String {
         rest = &tail[n..];
     }
     out.push_str(rest);
+    out.chars().take(300).collect()
+}
+
+/// `text` with every run of at least 8 bytes that also occurs in `token` (the whole token, or
+/// any piece an echo or a cut left) replaced by `hf_***`. Tokens are ASCII (an HTTP header
+/// carries them), so a matched run never splits a character.
+fn mask_fragments(text: &str, token: &[u8]) -> String {
+    const MIN: usize = 8;
+    let t = text.as_bytes();
+    let mut out = String::with_capacity(text.len());
+    let (mut i, mut copied) = (0, 0);
+    while i < t.len() {
+        let longest = (0..token.len())
+            .map(|j| t[i..].iter().zip(&token[j..]).take_while(|(a, b)| a == b).count())
+            .max()
+            .unwrap_or(0);
+        if longest >= MIN && token.is_ascii() {
+            out.push_str(&text[copied..i]);
+            out.push_str("hf_***");
+            i += longest;
+            copied = i;
+        } else {
+            i += 1;
+        }
+    }
+    out.push_str(&text[copied..]);
     out
 }
 
@@ -566,8 +590,13 @@ pub fn push(
         &[],
     )?;
     let commit = c.object(what, &text)?;
-    let Some(commit) = commit.get("commitOid").and_then(Value::as_str) else {
-        return Err(c.reply(what, "no commitOid: the commit cannot be confirmed", &text));
+    // A commit id is a hex digest (40 digits on the Hub); anything else confirms nothing.
+    let Some(commit) = commit
+        .get("commitOid")
+        .and_then(Value::as_str)
+        .filter(|c| !c.is_empty() && c.bytes().all(|b| b.is_ascii_hexdigit()))
+    else {
+        return Err(c.reply(what, "no commitOid (a hex commit id): the commit cannot be confirmed", &text));
     };
     Ok(PushReport {
         repo: repo.to_string(),
@@ -630,6 +659,12 @@ mod tests {
         assert_eq!(redact("bad s3cr3t-token here", &t), "bad hf_*** here");
         assert_eq!(redact("key hf_AbCdEf123456 and hf_ok", &t), "key hf_*** and hf_ok");
         assert_eq!(redact(&"x".repeat(1000), &t).len(), 300);
+        // Pieces of the token (an echo that dropped a character, a cut) are masked too, and the
+        // cut at 300 characters comes after the masking, so it cannot expose a prefix.
+        assert_eq!(redact("echo 3cr3t-tok and s3cr3t-t", &t), "echo hf_*** and hf_***");
+        assert_eq!(redact("short s3cr3t is kept", &t), "short s3cr3t is kept");
+        let cut = format!("{}s3cr3t-token", "y".repeat(292));
+        assert!(!redact(&cut, &t).contains("s3cr3t-t"), "{}", redact(&cut, &t));
     }
 
     #[test]
