@@ -12,7 +12,7 @@ LEVEL ?= default
 VENV ?= $(HOME)/.cache/hgym-venv
 PYTHON ?= python3
 
-.PHONY: all setup build test validate bench nightly lint fmt clean help leaderboard peers roofline
+.PHONY: all setup build test validate bench nightly lint fmt clean help leaderboard peers roofline python
 
 help:
 	@echo "make validate   build, then validate the D2Q9 solver on the cylinder at Re 100 (LEVEL=$(LEVEL); the rest: make nightly)"
@@ -21,6 +21,7 @@ help:
 	@echo "make roofline   hgym's copy bandwidth (the bench's roofline) beside STREAM's C copy, alternating"
 	@echo "make nightly    validations (default level), benchmarks, short trainings, leaderboard; results/nightly/summary.md"
 	@echo "make peers      install the peers hgym bench --peer runs beside ours (SB3, hydrogym[jax]; ~7 GB)"
+	@echo "make python     build the Python package (python/, an abi3 wheel) and install it into the test venv"
 	@echo "make lint       rustfmt and clippy"
 	@echo "make leaderboard  aggregate results/ into results/LEADERBOARD.md"
 
@@ -54,8 +55,17 @@ $(PEERS_VENV)/.installed: scripts/peers/requirements.txt
 build: setup
 	$(CARGO) build --release --locked
 
-test: setup
+test: setup python
 	HGYM_PYTHON=$(VENV)/bin/python $(CARGO) test --release --locked --workspace -- --show-output
+	HGYM=$(HGYM) $(VENV)/bin/python -m pytest -q python/tests
+
+# The Python package: `import hgym` registers every ID with Gymnasium. maturin builds the abi3
+# wheel (a workspace of its own in python/, so the root's tests never link libpython); pip
+# installs it into the test venv. Users run `pip install ./python` instead.
+WHEELS := $(CARGO_TARGET_DIR)/wheels
+python: setup build
+	$(VENV)/bin/maturin build --quiet --release --locked -m python/Cargo.toml -o $(WHEELS) -i $(VENV)/bin/python
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check --force-reinstall --no-deps --no-index --find-links $(WHEELS) hgym
 
 # The main job, under 10 minutes on 2 cores at the default level: the Re 100 cylinder against
 # the literature. Every other case runs in `make nightly` (`hgym validate cylinder|pinball|square`).
@@ -82,10 +92,13 @@ leaderboard: build
 
 lint:
 	$(CARGO) fmt --all -- --check
+	$(CARGO) fmt --manifest-path python/Cargo.toml -- --check
 	$(CARGO) clippy --release --workspace --all-targets -- -D warnings
+	$(CARGO) clippy --release --locked --manifest-path python/Cargo.toml -- -D warnings
 
 fmt:
 	$(CARGO) fmt --all
+	$(CARGO) fmt --manifest-path python/Cargo.toml
 
 clean:
 	$(CARGO) clean

@@ -247,6 +247,25 @@ pub fn field(path: &Path, title: &str, nx: usize, ny: usize, extent: [f64; 4], v
     Ok(())
 }
 
+/// A field (row-major from `y0` up, `NaN` grey) as an RGB image, `ny` rows of `nx` pixels with
+/// the top row at `y1` (as a picture is read), symmetric colour range `+-vmax`: what an
+/// environment's `render()` returns.
+pub fn field_rgb(nx: usize, ny: usize, values: &[f32], vmax: f64) -> Vec<u8> {
+    let vmax = vmax.max(1e-12);
+    let mut rgb = Vec::with_capacity(nx * ny * 3);
+    for j in (0..ny).rev() {
+        for &v in &values[j * nx..(j + 1) * nx] {
+            let RGBColor(r, g, b) = if v.is_finite() {
+                diverging(v as f64 / vmax)
+            } else {
+                RGBColor(90, 90, 90)
+            };
+            rgb.extend([r, g, b]);
+        }
+    }
+    rgb
+}
+
 /// The `q`-quantile of `|v|` over finite values (colour scales robust to a few extremes).
 pub fn abs_quantile(values: &[f32], q: f64) -> f64 {
     let mut a: Vec<f32> = values.iter().filter(|v| v.is_finite()).map(|v| v.abs()).collect();
@@ -417,4 +436,20 @@ pub fn bars(path: &Path, title: &str, y_label: &str, bars: &[(String, f64, f64)]
     }
     root.present().map_err(err(path))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn field_rgb_puts_the_top_of_the_domain_first_and_colours_by_sign() {
+        // 2 x 2 field: bottom row (-1, NaN), top row (1, 0).
+        let rgb = field_rgb(2, 2, &[-1.0, f32::NAN, 1.0, 0.0], 1.0);
+        assert_eq!(rgb.len(), 12);
+        assert_eq!(&rgb[0..3], &[190, 30, 40], "top-left: +1 is red");
+        assert_eq!(&rgb[3..6], &[255, 255, 255], "top-right: 0 is white");
+        assert_eq!(&rgb[6..9], &[30, 60, 180], "bottom-left: -1 is blue");
+        assert_eq!(&rgb[9..12], &[90, 90, 90], "a body (NaN) is grey");
+    }
 }

@@ -1,0 +1,370 @@
+//! `hgym._hgym`: hgym's flow environments behind PyO3, for the Gymnasium classes in
+//! `python/hgym/`. The Rust environment is the one `hgym train` and `hgym eval` run (same
+//! registry, specs, overrides and seeds), so an observation through Python is bitwise the
+//! Rust one (converted to float32 for Gymnasium's `Box`). The GIL is released while a solver
+//! steps; a vector environment steps its instances on Rust threads (rayon) in one call.
+
+use std::sync::Mutex;
+
+use hgym::env::{FlowEnv, Spec};
+use hgym::flow::Level;
+use hgym_agents::{EnvError, Info};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rayon::prelude::*;
+
+/// A user's mistake (unknown ID, bad override, bad action) is a `ValueError`; a failure of the
+/// run itself a `RuntimeError`. Messages are the Rust ones, word for word.
+fn env_error(e: EnvError) -> PyErr {
+    match e {
+        EnvError::Backend(m) => PyRuntimeError::new_err(m),
+        EnvError::NeedsReset => PyRuntimeError::new_err(e.to_string()),
+        e => PyValueError::new_err(e.to_string()),
+    }
+}
+
+fn level(name: &str) -> PyResult<Level> {
+    match name {
+        "coarse" => Ok(Level::Coarse),
+        "default" => Ok(Level::Default),
+        "fine" => Ok(Level::Fine),
+        other => Err(PyValueError::new_err(format!(
+            "level '{other}' is not one of 'coarse', 'default', 'fine'"
+        ))),
+    }
+}
+
+/// The spec of `id` with `overrides` (a JSON object of spec fields, as `[env]` in a train
+/// config) merged in and checked.
+fn spec(id: &str, overrides: Option<&str>) -> PyResult<Spec> {
+    let spec = hgym::env::lookup(id).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let Some(json) = overrides else { return Ok(spec) };
+    let table: toml::Table = serde_json::from_str(json).map_err(|e| {
+        PyValueError::new_err(format!(
+            "overrides of {id}: {e} (keyword values must be numbers, strings, booleans, lists or dicts; not None)"
+        ))
+    })?;
+    if table.is_empty() {
+        return Ok(spec);
+    }
+    spec.with_overrides(&table).map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+fn make(spec: &Spec, level: Level) -> PyResult<Box<dyn FlowEnv>> {
+    spec.make(level, hgym::env::default_cache_dir()).map_err(env_error)
+}
+
+fn info_dict<'py>(py: Python<'py>, info: &Info) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for (k, v) in &info.values {
+        d.set_item(k, *v)?;
+    }
+    for (k, v) in &info.text {
+        d.set_item(k, v)?;
+    }
+    Ok(d)
+}
+
+fn obs_array<'py>(py: Python<'py>, obs: &[f64]) -> Bound<'py, PyArray1<f32>> {
+    PyArray1::from_iter(py, obs.iter().map(|&v| v as f32))
+}
+
+fn bounds<'py>(py: Python<'py>, space: &hgym_agents::BoxSpace) -> (Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<f32>>) {
+    let f = |v: &[f64]| PyArray1::from_iter(py, v.iter().map(|&x| x as f32));
+    (f(&space.low), f(&space.high))
+}
+
+/// One environment. The Python class `hgym.HgymEnv` wraps it with Gymnasium's API.
+#[pyclass(module = "hgym._hgym")]
+struct Env {
+    env: Mutex<Box<dyn FlowEnv>>,
+    spec: Spec,
+    level: Level,
+}
+
+impl Env {
+    fn env(&self) -> PyResult<std::sync::MutexGuard<'_, Box<dyn FlowEnv>>> {
+        self.env
+            .lock()
+            .map_err(|_| PyRuntimeError::new_err("the environment failed in an earlier call; make a new one"))
+    }
+}
+
+#[pymethods]
+impl Env {
+    /// `Env(id, level="coarse", overrides=None)`: `overrides` is a JSON object of spec fields.
+    #[new]
+    #[pyo3(signature = (id, level = "coarse", overrides = None))]
+    fn new(id: &str, level: &str, overrides: Option<&str>) -> PyResult<Self> {
+        let lvl = self::level(level)?;
+        let spec = spec(id, overrides)?;
+        let env = make(&spec, lvl)?;
+        Ok(Env {
+            env: Mutex::new(env),
+            spec,
+            level: lvl,
+        })
+    }
+
+    #[getter]
+    fn id(&self) -> String {
+        self.spec.id().to_string()
+    }
+
+    #[getter]
+    fn level(&self) -> &'static str {
+        self.level.name()
+    }
+
+    /// The spec as TOML (what `hgym envs show ID` prints, overrides applied).
+    #[getter]
+    fn spec_toml(&self) -> String {
+        self.spec.to_toml()
+    }
+
+    #[getter]
+    fn spec_hash(&self) -> String {
+        self.spec.hash()
+    }
+
+    #[getter]
+    fn control_interval(&self) -> f64 {
+        self.spec.control_interval()
+    }
+
+    #[getter]
+    fn differentiable(&self) -> bool {
+        self.spec.differentiable()
+    }
+
+    /// `(low, high)` of the observation space, float32.
+    fn observation_bounds<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<f32>>)> {
+        Ok(bounds(py, &self.env()?.observation_space()))
+    }
+
+    /// `(low, high)` of the action space, float32.
+    fn action_bounds<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<f32>>)> {
+        Ok(bounds(py, &self.env()?.action_space()))
+    }
+
+    /// `reset(seed) -> (obs, info)`; the first reset of a flow spins it up (cached on disk).
+    fn reset<'py>(&self, py: Python<'py>, seed: u64) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyDict>)> {
+        let mut guard = self.env()?;
+        let env: &mut dyn FlowEnv = &mut **guard;
+        let (obs, info) = py.detach(|| env.reset(seed)).map_err(env_error)?;
+        Ok((obs_array(py, &obs), info_dict(py, &info)?))
+    }
+
+    /// `step(action) -> (obs, reward, terminated, truncated, info)`; `action` a float64 vector.
+    #[allow(clippy::type_complexity)]
+    fn step<'py>(
+        &self,
+        py: Python<'py>,
+        action: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<(Bound<'py, PyArray1<f32>>, f64, bool, bool, Bound<'py, PyDict>)> {
+        let action = action.as_slice().map_err(|e| PyValueError::new_err(format!("the action: {e}")))?;
+        let mut guard = self.env()?;
+        let env: &mut dyn FlowEnv = &mut **guard;
+        let r = py.detach(|| env.step(action)).map_err(env_error)?;
+        Ok((obs_array(py, &r.obs), r.reward, r.terminated, r.truncated, info_dict(py, &r.info)?))
+    }
+
+    /// The vorticity as an RGB image (rows from the top of the domain), float colour range
+    /// `+-vmax` (default: the 98th percentile of |vorticity|); bodies grey.
+    #[pyo3(signature = (vmax = None))]
+    fn render_rgb<'py>(&self, py: Python<'py>, vmax: Option<f64>) -> PyResult<Bound<'py, PyArray3<u8>>> {
+        let snap = self.env()?.snapshot();
+        let w = snap
+            .fields
+            .iter()
+            .find(|(name, _)| name == "vorticity")
+            .map(|(_, v)| v)
+            .ok_or_else(|| PyRuntimeError::new_err("this environment has no vorticity field"))?;
+        let vmax = vmax.unwrap_or_else(|| hgym::report::plots::abs_quantile(w, 0.98));
+        let rgb = hgym::report::plots::field_rgb(snap.nx, snap.ny, w, vmax);
+        PyArray1::from_vec(py, rgb)
+            .reshape([snap.ny, snap.nx, 3])
+            .map_err(|e| PyRuntimeError::new_err(e.to_string()))
+    }
+
+    /// For the last `k` steps, the gradient of their summed reward with respect to each step's
+    /// action (a `k x act_dim` float64 array; one adjoint sweep). Differentiable flows only.
+    fn reward_action_gradients<'py>(&self, py: Python<'py>, k: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let mut guard = self.env()?;
+        let env: &mut dyn FlowEnv = &mut **guard;
+        let g = py.detach(|| env.reward_action_gradients(k)).map_err(env_error)?;
+        PyArray2::from_vec2(py, &g).map_err(|e| PyRuntimeError::new_err(e.to_string()))
+    }
+}
+
+/// `n` environments of one ID, stepped together on Rust threads: `VecEnv(id, n, level,
+/// overrides)`. Each instance is the environment `Env` would make; instance `i` of a reset
+/// with seeds `s` gets seed `s[i]`, so the results are those of `n` separate environments.
+#[pyclass(module = "hgym._hgym")]
+struct VecEnv {
+    envs: Mutex<Vec<Box<dyn FlowEnv>>>,
+    spec: Spec,
+}
+
+impl VecEnv {
+    fn envs(&self) -> PyResult<std::sync::MutexGuard<'_, Vec<Box<dyn FlowEnv>>>> {
+        self.envs
+            .lock()
+            .map_err(|_| PyRuntimeError::new_err("the environments failed in an earlier call; make new ones"))
+    }
+}
+
+/// Rows of `rows` (all of length `width`) as a float32 matrix.
+fn matrix<'py>(py: Python<'py>, rows: &[Vec<f64>], width: usize) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let flat: Vec<f32> = rows.iter().flat_map(|r| r.iter().map(|&v| v as f32)).collect();
+    PyArray1::from_vec(py, flat)
+        .reshape([rows.len(), width])
+        .map_err(|e| PyRuntimeError::new_err(e.to_string()))
+}
+
+#[pymethods]
+impl VecEnv {
+    #[new]
+    #[pyo3(signature = (id, n, level = "coarse", overrides = None))]
+    fn new(id: &str, n: usize, level: &str, overrides: Option<&str>) -> PyResult<Self> {
+        if !(1..=4096).contains(&n) {
+            return Err(PyValueError::new_err(format!("n must be 1 to 4096 environments, got {n}")));
+        }
+        let lvl = self::level(level)?;
+        let spec = spec(id, overrides)?;
+        let envs = (0..n).map(|_| make(&spec, lvl)).collect::<PyResult<Vec<_>>>()?;
+        Ok(VecEnv {
+            envs: Mutex::new(envs),
+            spec,
+        })
+    }
+
+    #[getter]
+    fn num_envs(&self) -> PyResult<usize> {
+        Ok(self.envs()?.len())
+    }
+
+    #[getter]
+    fn id(&self) -> String {
+        self.spec.id().to_string()
+    }
+
+    /// `reset(seeds) -> (obs [n, obs_dim], infos)`: one seed per instance.
+    fn reset<'py>(&self, py: Python<'py>, seeds: Vec<u64>) -> PyResult<(Bound<'py, PyArray2<f32>>, Vec<Bound<'py, PyDict>>)> {
+        let mut guard = self.envs()?;
+        let envs: &mut Vec<Box<dyn FlowEnv>> = &mut guard;
+        if seeds.len() != envs.len() {
+            return Err(PyValueError::new_err(format!(
+                "{} seeds for {} environments: give one per environment",
+                seeds.len(),
+                envs.len()
+            )));
+        }
+        let out: Vec<_> = py
+            .detach(|| {
+                envs.par_iter_mut()
+                    .zip(seeds.par_iter())
+                    .map(|(e, &s)| e.reset(s))
+                    .collect::<Result<Vec<_>, _>>()
+            })
+            .map_err(env_error)?;
+        let obs: Vec<Vec<f64>> = out.iter().map(|(o, _)| o.clone()).collect();
+        let infos = out.iter().map(|(_, i)| info_dict(py, i)).collect::<PyResult<_>>()?;
+        Ok((matrix(py, &obs, self.spec.obs_dim())?, infos))
+    }
+
+    /// `(low, high)` of one instance's observation space, float32.
+    fn observation_bounds<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<f32>>)> {
+        Ok(bounds(py, &self.envs()?[0].observation_space()))
+    }
+
+    /// `(low, high)` of one instance's action space, float32.
+    fn action_bounds<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<f32>>)> {
+        Ok(bounds(py, &self.envs()?[0].action_space()))
+    }
+
+    /// `step(actions [n, act_dim], resets) -> (obs, rewards, terminated, truncated, infos)`.
+    /// `resets[i]` a seed: instance `i` resets with it instead of stepping (Gymnasium's
+    /// next-step autoreset), and returns its first observation with reward 0.
+    #[allow(clippy::type_complexity)]
+    fn step<'py>(
+        &self,
+        py: Python<'py>,
+        actions: PyReadonlyArray2<'py, f64>,
+        resets: Vec<Option<u64>>,
+    ) -> PyResult<(Bound<'py, PyArray2<f32>>, Vec<f64>, Vec<bool>, Vec<bool>, Vec<Bound<'py, PyDict>>)> {
+        let shape = actions.shape().to_vec();
+        let flat = actions.as_slice().map_err(|e| PyValueError::new_err(format!("the actions: {e}")))?;
+        let mut guard = self.envs()?;
+        let envs: &mut Vec<Box<dyn FlowEnv>> = &mut guard;
+        let n = envs.len();
+        let act_dim = self.spec.act_dim();
+        if shape != [n, act_dim] || resets.len() != n {
+            return Err(PyValueError::new_err(format!(
+                "actions have shape {shape:?} and {} reset entries; the vector environment needs [{n}, {act_dim}] and {n}",
+                resets.len()
+            )));
+        }
+        let out = py
+            .detach(|| {
+                envs.par_iter_mut()
+                    .zip(flat.par_chunks(act_dim.max(1)))
+                    .zip(resets.par_iter())
+                    .map(|((e, a), reset)| match reset {
+                        Some(seed) => e.reset(*seed).map(|(obs, info)| hgym_agents::StepResult {
+                            obs,
+                            reward: 0.0,
+                            terminated: false,
+                            truncated: false,
+                            info,
+                        }),
+                        None => e.step(a),
+                    })
+                    .collect::<Result<Vec<_>, _>>()
+            })
+            .map_err(env_error)?;
+        let obs: Vec<Vec<f64>> = out.iter().map(|r| r.obs.clone()).collect();
+        let infos = out.iter().map(|r| info_dict(py, &r.info)).collect::<PyResult<_>>()?;
+        Ok((
+            matrix(py, &obs, self.spec.obs_dim())?,
+            out.iter().map(|r| r.reward).collect(),
+            out.iter().map(|r| r.terminated).collect(),
+            out.iter().map(|r| r.truncated).collect(),
+            infos,
+        ))
+    }
+}
+
+/// Every registered ID with its spec's facts: a list of dicts.
+#[pyfunction]
+fn envs(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
+    hgym::env::registry::all()
+        .iter()
+        .map(|s| {
+            let d = PyDict::new(py);
+            d.set_item("id", s.id())?;
+            d.set_item("family", s.family())?;
+            d.set_item("solver", s.solver())?;
+            d.set_item("dimension", s.dimension())?;
+            d.set_item("reynolds", s.reynolds())?;
+            d.set_item("obs_dim", s.obs_dim())?;
+            d.set_item("act_dim", s.act_dim())?;
+            d.set_item("control_interval", s.control_interval())?;
+            d.set_item("differentiable", s.differentiable())?;
+            d.set_item("spec_hash", s.hash())?;
+            d.set_item("spec_toml", s.to_toml())?;
+            Ok(d)
+        })
+        .collect()
+}
+
+#[pymodule]
+fn _hgym(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Env>()?;
+    m.add_class::<VecEnv>()?;
+    m.add_function(wrap_pyfunction!(envs, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
