@@ -67,11 +67,16 @@ fn info_dict<'py>(py: Python<'py>, info: &Info) -> PyResult<Bound<'py, PyDict>> 
     Ok(d)
 }
 
+/// An observation (float32), `(low, high)` of a space, and the infos of a vector step.
+type Obs<'py> = Bound<'py, PyArray1<f32>>;
+type Bounds<'py> = (Obs<'py>, Obs<'py>);
+type Infos<'py> = Vec<Bound<'py, PyDict>>;
+
 fn obs_array<'py>(py: Python<'py>, obs: &[f64]) -> Bound<'py, PyArray1<f32>> {
     PyArray1::from_iter(py, obs.iter().map(|&v| v as f32))
 }
 
-fn bounds<'py>(py: Python<'py>, space: &hgym_agents::BoxSpace) -> (Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<f32>>) {
+fn bounds<'py>(py: Python<'py>, space: &hgym_agents::BoxSpace) -> Bounds<'py> {
     let f = |v: &[f64]| PyArray1::from_iter(py, v.iter().map(|&x| x as f32));
     (f(&space.low), f(&space.high))
 }
@@ -140,17 +145,17 @@ impl Env {
     }
 
     /// `(low, high)` of the observation space, float32.
-    fn observation_bounds<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<f32>>)> {
+    fn observation_bounds<'py>(&self, py: Python<'py>) -> PyResult<Bounds<'py>> {
         Ok(bounds(py, &self.env()?.observation_space()))
     }
 
     /// `(low, high)` of the action space, float32.
-    fn action_bounds<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<f32>>)> {
+    fn action_bounds<'py>(&self, py: Python<'py>) -> PyResult<Bounds<'py>> {
         Ok(bounds(py, &self.env()?.action_space()))
     }
 
     /// `reset(seed) -> (obs, info)`; the first reset of a flow spins it up (cached on disk).
-    fn reset<'py>(&self, py: Python<'py>, seed: u64) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyDict>)> {
+    fn reset<'py>(&self, py: Python<'py>, seed: u64) -> PyResult<(Obs<'py>, Bound<'py, PyDict>)> {
         let mut guard = self.env()?;
         let env: &mut dyn FlowEnv = &mut **guard;
         let (obs, info) = py.detach(|| env.reset(seed)).map_err(env_error)?;
@@ -252,7 +257,7 @@ impl VecEnv {
     }
 
     /// `reset(seeds) -> (obs [n, obs_dim], infos)`: one seed per instance.
-    fn reset<'py>(&self, py: Python<'py>, seeds: Vec<u64>) -> PyResult<(Bound<'py, PyArray2<f32>>, Vec<Bound<'py, PyDict>>)> {
+    fn reset<'py>(&self, py: Python<'py>, seeds: Vec<u64>) -> PyResult<(Bound<'py, PyArray2<f32>>, Infos<'py>)> {
         let mut guard = self.envs()?;
         let envs: &mut Vec<Box<dyn FlowEnv>> = &mut guard;
         if seeds.len() != envs.len() {
@@ -276,12 +281,12 @@ impl VecEnv {
     }
 
     /// `(low, high)` of one instance's observation space, float32.
-    fn observation_bounds<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<f32>>)> {
+    fn observation_bounds<'py>(&self, py: Python<'py>) -> PyResult<Bounds<'py>> {
         Ok(bounds(py, &self.envs()?[0].observation_space()))
     }
 
     /// `(low, high)` of one instance's action space, float32.
-    fn action_bounds<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyArray1<f32>>)> {
+    fn action_bounds<'py>(&self, py: Python<'py>) -> PyResult<Bounds<'py>> {
         Ok(bounds(py, &self.envs()?[0].action_space()))
     }
 
