@@ -77,8 +77,7 @@ fn obs_array<'py>(py: Python<'py>, obs: &[f64]) -> Bound<'py, PyArray1<f32>> {
 }
 
 fn bounds<'py>(py: Python<'py>, space: &hgym_agents::BoxSpace) -> Bounds<'py> {
-    let f = |v: &[f64]| PyArray1::from_iter(py, v.iter().map(|&x| x as f32));
-    (f(&space.low), f(&space.high))
+    (obs_array(py, &space.low), obs_array(py, &space.high))
 }
 
 /// One environment. The Python class `hgym.HgymEnv` wraps it with Gymnasium's API.
@@ -222,10 +221,10 @@ impl VecEnv {
 }
 
 /// Rows of `rows` (all of length `width`) as a float32 matrix.
-fn matrix<'py>(py: Python<'py>, rows: &[Vec<f64>], width: usize) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let flat: Vec<f32> = rows.iter().flat_map(|r| r.iter().map(|&v| v as f32)).collect();
-    PyArray1::from_vec(py, flat)
-        .reshape([rows.len(), width])
+fn matrix<'a, 'py>(py: Python<'py>, rows: impl ExactSizeIterator<Item = &'a [f64]>, width: usize) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let n = rows.len();
+    PyArray1::from_iter(py, rows.flat_map(|r| r.iter().map(|&v| v as f32)))
+        .reshape([n, width])
         .map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
 
@@ -275,9 +274,9 @@ impl VecEnv {
                     .collect::<Result<Vec<_>, _>>()
             })
             .map_err(env_error)?;
-        let obs: Vec<Vec<f64>> = out.iter().map(|(o, _)| o.clone()).collect();
+        let obs = out.iter().map(|(o, _)| o.as_slice());
         let infos = out.iter().map(|(_, i)| info_dict(py, i)).collect::<PyResult<_>>()?;
-        Ok((matrix(py, &obs, self.spec.obs_dim())?, infos))
+        Ok((matrix(py, obs, self.spec.obs_dim())?, infos))
     }
 
     /// `(low, high)` of one instance's observation space, float32.
@@ -330,10 +329,9 @@ impl VecEnv {
                     .collect::<Result<Vec<_>, _>>()
             })
             .map_err(env_error)?;
-        let obs: Vec<Vec<f64>> = out.iter().map(|r| r.obs.clone()).collect();
         let infos = out.iter().map(|r| info_dict(py, &r.info)).collect::<PyResult<_>>()?;
         Ok((
-            matrix(py, &obs, self.spec.obs_dim())?,
+            matrix(py, out.iter().map(|r| r.obs.as_slice()), self.spec.obs_dim())?,
             out.iter().map(|r| r.reward).collect(),
             out.iter().map(|r| r.terminated).collect(),
             out.iter().map(|r| r.truncated).collect(),
