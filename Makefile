@@ -12,6 +12,10 @@ LEVEL ?= default
 VENV ?= $(HOME)/.cache/hgym-venv
 PYTHON ?= python3
 
+# `!(x <= limit)` is how the checks refuse NaN along with values out of range (a NaN compares
+# false): the lint that asks for partial_cmp there would make each check longer, not clearer.
+CLIPPY_ALLOW := -A clippy::neg_cmp_op_on_partial_ord
+
 .PHONY: all setup build test validate bench nightly lint fmt clean help leaderboard peers roofline python
 
 help:
@@ -83,7 +87,7 @@ $(CARGO_TARGET_DIR)/stream_copy: benchmarks/stream/copy.c
 roofline: build $(CARGO_TARGET_DIR)/stream_copy
 	HGYM=$(HGYM) C_COPY=$(CARGO_TARGET_DIR)/stream_copy scripts/roofline.sh
 
-nightly: build
+nightly: build python
 	HGYM=$(HGYM) scripts/nightly.sh
 
 leaderboard: build
@@ -93,8 +97,8 @@ leaderboard: build
 lint:
 	$(CARGO) fmt --all -- --check
 	$(CARGO) fmt --manifest-path python/Cargo.toml -- --check
-	$(CARGO) clippy --release --workspace --all-targets -- -D warnings
-	$(CARGO) clippy --release --locked --manifest-path python/Cargo.toml -- -D warnings
+	$(CARGO) clippy --release --workspace --all-targets -- -D warnings $(CLIPPY_ALLOW)
+	$(CARGO) clippy --release --locked --manifest-path python/Cargo.toml -- -D warnings $(CLIPPY_ALLOW)
 
 fmt:
 	$(CARGO) fmt --all

@@ -150,7 +150,7 @@ fn answer(req: &Request, h: &mut Hub, port: u16) -> (u16, String, String) {
     let json = |b: &[u8]| serde_json::from_slice::<serde_json::Value>(b).unwrap_or_default();
     let hub_call = req.path.starts_with("/api/") || req.path.contains(".git/");
     if hub_call && req.auth.as_deref() != Some(&format!("Bearer {TOKEN}")) {
-        return (401, "".into(), r#"{"error":"Invalid credentials in Authorization header"}"#.into());
+        return reply(401, "", r#"{"error":"Invalid credentials in Authorization header"}"#);
     }
     let creates = h.requests.iter().filter(|r| r.path == "/api/repos/create").count();
     let m = h.misbehave;

@@ -111,7 +111,7 @@ impl KolmogorovSpec {
                 self.control_wavenumbers
             ));
         }
-        for level in [Level::Coarse, Level::Default, Level::Fine] {
+        for level in Level::ALL {
             let n = self.n(level);
             if self.probes_per_side == 0 || !n.is_multiple_of(self.probes_per_side) {
                 return Err(format!(

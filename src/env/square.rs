@@ -93,7 +93,7 @@ mod tests {
     /// the same to round-off.
     #[test]
     fn every_jet_is_resolved_at_every_level_and_mirror_jets_agree() {
-        for level in [Level::Coarse, Level::Default, Level::Fine] {
+        for level in Level::ALL {
             let mut env = LbmEnv::new(square(200), level, None).unwrap();
             let blow = env.actuator_mass_sources(1.0);
             let suck = env.actuator_mass_sources(-1.0);

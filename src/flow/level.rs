@@ -19,6 +19,24 @@ impl Level {
             Level::Fine => "fine",
         }
     }
+
+    pub const ALL: [Level; 3] = [Level::Coarse, Level::Default, Level::Fine];
+}
+
+/// A level name that is not `coarse`, `default` or `fine`.
+#[derive(Debug, thiserror::Error)]
+#[error("level '{0}' is not one of 'coarse', 'default', 'fine'")]
+pub struct UnknownLevel(pub String);
+
+impl std::str::FromStr for Level {
+    type Err = UnknownLevel;
+
+    fn from_str(name: &str) -> Result<Self, Self::Err> {
+        Level::ALL
+            .into_iter()
+            .find(|l| l.name() == name)
+            .ok_or_else(|| UnknownLevel(name.to_string()))
+    }
 }
 
 /// Cells per reference length at each level.
@@ -37,5 +55,19 @@ impl ResolutionSpec {
             Level::Default => self.default,
             Level::Fine => self.fine,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_parse_back_and_others_are_refused() {
+        for level in Level::ALL {
+            assert_eq!(level.name().parse::<Level>().ok(), Some(level));
+        }
+        let err = "medium".parse::<Level>().unwrap_err().to_string();
+        assert!(err.contains("'medium'") && err.contains("'coarse', 'default', 'fine'"), "{err}");
     }
 }

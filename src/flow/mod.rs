@@ -30,7 +30,7 @@ pub use domain::{BoundaryKind, BoundarySpec, DomainSpec, EdgeName, SpongeSpec};
 pub use field::{vorticity_field, Field};
 pub use geometry::GeometrySpec;
 pub use inlet::{InletSpec, Profile, VelocityReference};
-pub use level::{Level, ResolutionSpec};
+pub use level::{Level, ResolutionSpec, UnknownLevel};
 pub use plan::{FlowPlan, RefinementPlan, RefinementSpec, MAX_LATTICE_SPEED, MAX_NODES};
 
 /// `[a, b]` and nothing else: TOML readers fill a fixed-size array from the front and drop what
