@@ -60,6 +60,19 @@ struct Fields {
     wy: Vec<f64>,
 }
 
+/// `rayon::join(a, b)`, or `a` then `b` on the calling thread when the pool has one thread: a
+/// join from outside the pool moves both halves to a worker and back, which costs more than the
+/// transforms at small N when nothing can run beside them. Either way each half runs the same
+/// code on its own buffers, so the results are bitwise the same.
+fn join(a: impl FnOnce() + Send, b: impl FnOnce() + Send) {
+    if rayon::current_num_threads() == 1 {
+        a();
+        b();
+    } else {
+        rayon::join(a, b);
+    }
+}
+
 impl Fields {
     fn new(m: usize) -> Self {
         Fields {
@@ -333,7 +346,7 @@ impl Kolmogorov {
         let (fa, fb) = (&mut self.fft, &mut self.fft_b);
         // Two independent pairs of transforms, one per thread (each transform is computed the
         // same way on either, so results do not depend on the thread count).
-        rayon::join(
+        join(
             || {
                 fa.inverse_destroying(s0, u);
                 fa.inverse_destroying(s1, v);
@@ -438,7 +451,7 @@ impl Kolmogorov {
         let (pa, pb) = (&mut self.w.prod, &mut self.w.prod_b);
         let mu = &self.w.mu;
         let product = |p: &mut Vec<f64>, a: &[f64]| p.iter_mut().zip(a).zip(mu).for_each(|((p, a), b)| *p = a * b);
-        rayon::join(
+        join(
             || {
                 product(pa, &f.wx);
                 fa.forward_destroying(pa, s1);
