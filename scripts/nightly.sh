@@ -30,6 +30,7 @@ step bench-refine     "$HGYM" bench refine
 step bench-agents     "$HGYM" bench agents
 step bench-kolmogorov "$HGYM" bench kolmogorov
 step bench-envs       "$HGYM" bench envs --quick
+step bench-python     "$HGYM" bench python
 for algo in ppo ddpg td3 gppo; do
   step "train-$algo" "$HGYM" train --env Kolmogorov_2D_Re40 --algo "$algo" --steps 2000 --out "$OUT/train"
 done

@@ -520,6 +520,21 @@ fn bench_refine_quick_reports_the_ratio_to_the_uniform_kernel() {
 }
 
 #[test]
+fn bench_python_without_the_package_says_how_to_build_it() {
+    let o = Command::new(env!("CARGO_BIN_EXE_hgym"))
+        .args(["bench", "python", "--quick"])
+        .env("HGYM_PYTHON", "/nonexistent/bin/python")
+        .output()
+        .unwrap();
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("/nonexistent/bin/python not found") && err.contains("make python"),
+        "{err}"
+    );
+}
+
+#[test]
 fn bench_envs_times_only_the_families_asked_for() {
     let o = hgym(&["bench", "envs", "--family", "pinbal"]);
     let (_, err) = text(&o);

@@ -26,14 +26,8 @@ fn env_error(e: EnvError) -> PyErr {
 }
 
 fn level(name: &str) -> PyResult<Level> {
-    match name {
-        "coarse" => Ok(Level::Coarse),
-        "default" => Ok(Level::Default),
-        "fine" => Ok(Level::Fine),
-        other => Err(PyValueError::new_err(format!(
-            "level '{other}' is not one of 'coarse', 'default', 'fine'"
-        ))),
-    }
+    name.parse()
+        .map_err(|e: hgym::flow::UnknownLevel| PyValueError::new_err(e.to_string()))
 }
 
 /// The spec of `id` with `overrides` (a JSON object of spec fields, as `[env]` in a train
@@ -50,6 +44,13 @@ fn spec(id: &str, overrides: Option<&str>) -> PyResult<Spec> {
         return Ok(spec);
     }
     spec.with_overrides(&table).map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// `f` with the GIL released, on a worker of rayon's pool (where `hgym train` steps its
+/// environments): a solver's parallel loops then start inside the pool instead of each handing
+/// its work over from Python's thread and waiting for it; one hand-over per call remains.
+fn detached<R: Send>(py: Python<'_>, f: impl FnOnce() -> R + Send) -> R {
+    py.detach(|| rayon::scope(|_| f()))
 }
 
 fn make(spec: &Spec, level: Level) -> PyResult<Box<dyn FlowEnv>> {
@@ -157,7 +158,7 @@ impl Env {
     fn reset<'py>(&self, py: Python<'py>, seed: u64) -> PyResult<(Obs<'py>, Bound<'py, PyDict>)> {
         let mut guard = self.env()?;
         let env: &mut dyn FlowEnv = &mut **guard;
-        let (obs, info) = py.detach(|| env.reset(seed)).map_err(env_error)?;
+        let (obs, info) = detached(py, || env.reset(seed)).map_err(env_error)?;
         Ok((obs_array(py, &obs), info_dict(py, &info)?))
     }
 
@@ -171,7 +172,7 @@ impl Env {
         let action = action.as_slice().map_err(|e| PyValueError::new_err(format!("the action: {e}")))?;
         let mut guard = self.env()?;
         let env: &mut dyn FlowEnv = &mut **guard;
-        let r = py.detach(|| env.step(action)).map_err(env_error)?;
+        let r = detached(py, || env.step(action)).map_err(env_error)?;
         Ok((obs_array(py, &r.obs), r.reward, r.terminated, r.truncated, info_dict(py, &r.info)?))
     }
 
@@ -198,7 +199,7 @@ impl Env {
     fn reward_action_gradients<'py>(&self, py: Python<'py>, k: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let mut guard = self.env()?;
         let env: &mut dyn FlowEnv = &mut **guard;
-        let g = py.detach(|| env.reward_action_gradients(k)).map_err(env_error)?;
+        let g = detached(py, || env.reward_action_gradients(k)).map_err(env_error)?;
         PyArray2::from_vec2(py, &g).map_err(|e| PyRuntimeError::new_err(e.to_string()))
     }
 }
@@ -266,14 +267,13 @@ impl VecEnv {
                 envs.len()
             )));
         }
-        let out: Vec<_> = py
-            .detach(|| {
-                envs.par_iter_mut()
-                    .zip(seeds.par_iter())
-                    .map(|(e, &s)| e.reset(s))
-                    .collect::<Result<Vec<_>, _>>()
-            })
-            .map_err(env_error)?;
+        let out: Vec<_> = detached(py, || {
+            envs.par_iter_mut()
+                .zip(seeds.par_iter())
+                .map(|(e, &s)| e.reset(s))
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .map_err(env_error)?;
         let obs = out.iter().map(|(o, _)| o.as_slice());
         let infos = out.iter().map(|(_, i)| info_dict(py, i)).collect::<PyResult<_>>()?;
         Ok((matrix(py, obs, self.spec.obs_dim())?, infos))
@@ -311,24 +311,23 @@ impl VecEnv {
                 resets.len()
             )));
         }
-        let out = py
-            .detach(|| {
-                envs.par_iter_mut()
-                    .zip(flat.par_chunks(act_dim.max(1)))
-                    .zip(resets.par_iter())
-                    .map(|((e, a), reset)| match reset {
-                        Some(seed) => e.reset(*seed).map(|(obs, info)| hgym_agents::StepResult {
-                            obs,
-                            reward: 0.0,
-                            terminated: false,
-                            truncated: false,
-                            info,
-                        }),
-                        None => e.step(a),
-                    })
-                    .collect::<Result<Vec<_>, _>>()
-            })
-            .map_err(env_error)?;
+        let out = detached(py, || {
+            envs.par_iter_mut()
+                .zip(flat.par_chunks(act_dim.max(1)))
+                .zip(resets.par_iter())
+                .map(|((e, a), reset)| match reset {
+                    Some(seed) => e.reset(*seed).map(|(obs, info)| hgym_agents::StepResult {
+                        obs,
+                        reward: 0.0,
+                        terminated: false,
+                        truncated: false,
+                        info,
+                    }),
+                    None => e.step(a),
+                })
+                .collect::<Result<Vec<_>, _>>()
+        })
+        .map_err(env_error)?;
         let infos = out.iter().map(|r| info_dict(py, &r.info)).collect::<PyResult<_>>()?;
         Ok((
             matrix(py, out.iter().map(|r| r.obs.as_slice()), self.spec.obs_dim())?,

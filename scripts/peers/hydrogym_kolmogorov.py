@@ -9,6 +9,9 @@ in one process lifetime (A B A B):
                       one control action (the env's action time at its dt) through the env's
                       jitted `step_env`: gymnax's `step` also runs `reset_env` on every call for
                       its auto-reset (a second rollout of the same length), which is not counted
+    gym_action     -> {"s_per_action": ...}
+                      one control action through gymnax's Gymnasium wrapper (`GymnaxToGymWrapper`,
+                      what a Gymnasium user steps: the jitted `step` with its auto-reset rollout)
     accuracy       -> {"dt": ..., "reference_dt": ..., "relative_error": ...}
                       the relative L2 error of the vorticity after one action at the env's dt
                       against the same action at a quarter of it, from the same developed state
@@ -34,6 +37,7 @@ if threads == 1:
 import hydrogym  # noqa: E402
 import jax  # noqa: E402
 import jax.numpy as jnp  # noqa: E402
+from gymnax.wrappers.gym import GymnaxToGymWrapper  # noqa: E402
 from hydrogym.jax.envs.kolmogorov import KolmogorovFlow  # noqa: E402
 
 KolmogorovFlow.is_terminated = lambda self, state, params: state.terminal
@@ -62,6 +66,7 @@ def main():
     # intervals of `save_time // dt` steps (9990 at dt 1e-3).
     per_save = int(params.save_time // params.dt)
     steps = int(params.action_time // params.dt) // per_save * per_save
+    gym_env = None
     for line in sys.stdin:
         words = line.split()
         if not words:
@@ -82,6 +87,16 @@ def main():
             jax.block_until_ready(state.omega_hat)
             wall = time.perf_counter() - t
             out = {"steps_per_s": steps / wall, "s_per_action": wall, "steps": steps}
+        elif words[0] == "gym_action":
+            if gym_env is None:
+                # A fresh env: the wrapper deep-copies it, and `env` holds tracers from `step`'s jit.
+                fresh, fresh_params, _ = make(DT)
+                gym_env = GymnaxToGymWrapper(fresh, fresh_params)
+                gym_env.reset(seed=0)
+                jax.block_until_ready(gym_env.step(zero)[0])  # compiles
+            t = time.perf_counter()
+            jax.block_until_ready(gym_env.step(zero)[0])
+            out = {"s_per_action": time.perf_counter() - t}
         elif words[0] == "accuracy":
             _, _, fine_step = make(DT / 4)
             a = step(key, state, zero).omega_hat

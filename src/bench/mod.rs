@@ -18,6 +18,7 @@ pub mod envs;
 pub mod kolmogorov;
 mod lbm;
 pub mod peer;
+pub mod python;
 mod refine;
 mod stream;
 

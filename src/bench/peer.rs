@@ -219,7 +219,7 @@ pub fn describe(about: &serde_json::Value) -> String {
     format!("{name} ({})", rest.join(", ").replace('"', ""))
 }
 
-fn median(v: &[f64]) -> f64 {
+pub(crate) fn median(v: &[f64]) -> f64 {
     let mut s = v.to_vec();
     s.sort_by(f64::total_cmp);
     match s.len() {

@@ -58,6 +58,23 @@ pub enum BenchCommand {
     /// alternating with ours, with each one's step size and accuracy per control action. Exit 1 if
     /// a VJP costs more than 3 steps; 2 if --peer is given and the peers are not installed.
     Kolmogorov(#[command(flatten)] PeerBenchArgs),
+    /// hgym from Python: the boundary's overhead per step (HgymEnv.step against the same env
+    /// stepped in Rust, alternating) and the vector env's throughput against the Rust loop, 1 and
+    /// 2 threads. Needs the package (`make python`; the interpreter is $HGYM_PYTHON, else
+    /// ~/.cache/hgym-venv/bin/python). With --peer, HydroGym's JAX Kolmogorov env through its
+    /// Gymnasium wrapper beside hgym's, per control action. Exit 1 if the overhead is 5 us or more
+    /// or the vector env reaches less than 95 % of the Rust loop.
+    Python {
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+        /// Short timings (targets not judged).
+        #[arg(long)]
+        quick: bool,
+        /// Time HydroGym's Kolmogorov env beside ours (`make peers` installs it).
+        #[arg(long)]
+        peer: bool,
+    },
     /// Control steps (actions) per second of each environment family at coarse and default.
     Envs {
         /// Print the rows as JSON.
@@ -126,6 +143,7 @@ pub fn run(cmd: BenchCommand) -> Result<Outcome> {
             family,
         } => run_bench_envs(json, actions, quick, &family),
         BenchCommand::Agents(args) => run_bench_agents(args),
+        BenchCommand::Python { json, quick, peer } => run_bench_python(json, quick, peer),
         BenchCommand::Kolmogorov(PeerBenchArgs {
             json,
             quick,
@@ -251,5 +269,33 @@ fn run_bench_agents(
     } else {
         print!("{}", hgym::bench::agents::table(&b));
     }
+    Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
+}
+
+/// The interpreter with hgym's package: `$HGYM_PYTHON`, else the test venv `make python` fills.
+fn hgym_python() -> std::path::PathBuf {
+    if let Some(p) = std::env::var_os("HGYM_PYTHON") {
+        return p.into();
+    }
+    let home = std::env::var_os("HOME").map_or_else(|| std::path::PathBuf::from("."), std::path::PathBuf::from);
+    home.join(".cache/hgym-venv/bin/python")
+}
+
+fn run_bench_python(json: bool, quick: bool, peer: bool) -> Result<Outcome> {
+    let python = hgym_python();
+    if !python.exists() {
+        return Err(UsageError(format!(
+            "{} not found: run `make python` (builds the package into ~/.cache/hgym-venv), or set HGYM_PYTHON to an interpreter that has it",
+            python.display()
+        ))
+        .into());
+    }
+    let mut peer = start_peer(peer, hgym::bench::peer::HYDROGYM_KOLMOGOROV, 2)?;
+    let b = hgym::bench::python::bench_python(&python, quick, peer.as_mut(), &mut |m| {
+        if !json {
+            eprintln!("{m}");
+        }
+    })?;
+    print_report(json, &b, &hgym::bench::python::table(&b))?;
     Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
 }
