@@ -37,9 +37,21 @@ pub struct LeaderboardArgs {
     json: bool,
 }
 
+/// The spec hash today's registry gives `id` with a run's training configuration (its `[env]`
+/// overrides); without one, the registered spec's.
+fn current_hash(id: &str, config_toml: Option<&str>) -> Option<String> {
+    match config_toml {
+        Some(text) => {
+            let config = hgym::train::config::TrainConfig::parse(text, "a run's manifest").ok()?;
+            hgym::train::resolve_spec(id, &config).ok().map(|s| s.hash())
+        }
+        None => hgym::env::lookup(id).ok().map(|s| s.hash()),
+    }
+}
+
 /// `hgym leaderboard`: writes results/leaderboard.json, LEADERBOARD.md and the bar charts.
 pub fn leaderboard(args: LeaderboardArgs) -> Result<Outcome> {
-    let lb = hgym::report::leaderboard::build(&args.results, args.env.as_deref());
+    let lb = hgym::report::leaderboard::build(&args.results, args.env.as_deref(), &current_hash);
     hgym::report::leaderboard::write(&args.results, &lb)?;
     if !lb.problems.is_empty() {
         eprintln!(

@@ -8,6 +8,10 @@
 //! level, algorithm or baseline); per entry: seeds, mean +- std over seeds of the drag reduction
 //! (for flows with a drag coefficient) and of the return, samples, wall time, code versions.
 //! Ranking: by drag reduction where there is one, else by return.
+//!
+//! An entry whose spec hash is not the one today's registry gives its runs (the registered spec
+//! with the run's `[env]` overrides) is *stale*: the environment it was trained on no longer
+//! exists. Stale entries are kept, in a section of their own, never ranked with current ones.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -33,6 +37,9 @@ pub struct Entry {
     pub wall_time_s: Option<f64>,
     pub code_versions: Vec<String>,
     pub runs: Vec<PathBuf>,
+    /// The spec hash is not the current one for these runs (see the module's doc).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub stale: bool,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -61,8 +68,14 @@ struct Run {
     samples: Option<u64>,
     wall: Option<f64>,
     version: Option<String>,
+    /// The run's training configuration (its `[env]` overrides change the spec).
+    config_toml: Option<String>,
     dir: PathBuf,
 }
+
+/// The spec hash today's registry gives an environment ID with a run's training configuration
+/// (`None`: the ID or the configuration is unknown today).
+pub type CurrentHash<'a> = &'a dyn Fn(&str, Option<&str>) -> Option<String>;
 
 fn read_json(p: &Path) -> Result<serde_json::Value, String> {
     let text = std::fs::read_to_string(p).map_err(|e| format!("cannot read {}: {e}", p.display()))?;
@@ -134,14 +147,16 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Probl
                 .as_str()
                 .map(|c| format!("{} ({c})", manifest["manifest"]["code_version"].as_str().unwrap_or("hgym")))
                 .or_else(|| manifest["manifest"]["code_version"].as_str().map(|s| s.to_string())),
+            config_toml: manifest["config_toml"].as_str().map(str::to_string),
             dir: shown,
             report,
         });
     }
 }
 
-/// Builds the leaderboard from everything under `results` (optionally one environment).
-pub fn build(results: &Path, env: Option<&str>) -> Leaderboard {
+/// Builds the leaderboard from everything under `results` (optionally one environment);
+/// `current` tells which spec hashes are today's.
+pub fn build(results: &Path, env: Option<&str>, current: CurrentHash) -> Leaderboard {
     let (mut runs, mut problems) = (vec![], vec![]);
     collect(results, results.parent().unwrap_or(Path::new(".")), &mut runs, &mut problems);
     let mut groups: BTreeMap<(String, String, String, String), Vec<Run>> = BTreeMap::new();
@@ -158,7 +173,11 @@ pub fn build(results: &Path, env: Option<&str>) -> Leaderboard {
             versions.dedup();
             let samples: Vec<u64> = runs.iter().filter_map(|r| r.samples).collect();
             let walls: Vec<f64> = runs.iter().filter_map(|r| r.wall).collect();
+            let stale = runs
+                .iter()
+                .any(|r| current(&env_id, r.config_toml.as_deref()).as_deref() != Some(spec_hash.as_str()));
             Entry {
+                stale,
                 kind: runs[0].kind.to_string(),
                 seeds: runs.len(),
                 drag_reduction_pct: col(&|r| r.report.drag_reduction_pct.mean),
@@ -183,8 +202,8 @@ pub fn build(results: &Path, env: Option<&str>) -> Leaderboard {
         }
     };
     entries.sort_by(|a, b| {
-        (&a.env_id, &a.level, &a.spec_hash)
-            .cmp(&(&b.env_id, &b.level, &b.spec_hash))
+        (a.stale, &a.env_id, &a.level, &a.spec_hash)
+            .cmp(&(b.stale, &b.env_id, &b.level, &b.spec_hash))
             .then(key(b).total_cmp(&key(a)))
     });
     Leaderboard {
@@ -211,7 +230,13 @@ pub fn markdown(lb: &Leaderboard) -> String {
     );
     let mut last = (String::new(), String::new(), String::new());
     let mut rank = 0;
+    let mut stale_heading = false;
     for e in &lb.entries {
+        if e.stale && !stale_heading {
+            stale_heading = true;
+            s += "\n# Stale: trained on specs that are no longer registered\n\nThe environments below have changed since these runs (another spec hash for the same ID); \
+                  their numbers are not comparable with the sections above and are kept for the record.\n";
+        }
         let group = (e.env_id.clone(), e.level.clone(), e.spec_hash.clone());
         if group != last {
             last = group;
