@@ -37,11 +37,16 @@ pub enum PeerError {
 
 /// The peers' interpreter.
 pub fn python() -> PathBuf {
-    if let Some(p) = std::env::var_os("HGYM_PEERS_PYTHON") {
+    interpreter("HGYM_PEERS_PYTHON", "hgym-peers")
+}
+
+/// `$var` if set, else the Python of the venv `~/.cache/<venv>` that a Makefile target creates.
+pub fn interpreter(var: &str, venv: &str) -> PathBuf {
+    if let Some(p) = std::env::var_os(var) {
         return PathBuf::from(p);
     }
     let home = std::env::var_os("HOME").map_or_else(|| PathBuf::from("."), PathBuf::from);
-    home.join(".cache/hgym-peers/bin/python")
+    home.join(".cache").join(venv).join("bin/python")
 }
 
 /// A running peer.

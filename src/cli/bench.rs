@@ -272,17 +272,9 @@ fn run_bench_agents(
     Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
 }
 
-/// The interpreter with hgym's package: `$HGYM_PYTHON`, else the test venv `make python` fills.
-fn hgym_python() -> std::path::PathBuf {
-    if let Some(p) = std::env::var_os("HGYM_PYTHON") {
-        return p.into();
-    }
-    let home = std::env::var_os("HOME").map_or_else(|| std::path::PathBuf::from("."), std::path::PathBuf::from);
-    home.join(".cache/hgym-venv/bin/python")
-}
-
 fn run_bench_python(json: bool, quick: bool, peer: bool) -> Result<Outcome> {
-    let python = hgym_python();
+    // The interpreter with hgym's package: `$HGYM_PYTHON`, else the test venv `make python` fills.
+    let python = hgym::bench::peer::interpreter("HGYM_PYTHON", "hgym-venv");
     if !python.exists() {
         return Err(UsageError(format!(
             "{} not found: run `make python` (builds the package into ~/.cache/hgym-venv), or set HGYM_PYTHON to an interpreter that has it",
