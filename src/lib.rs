@@ -2,7 +2,7 @@
 //!
 //! This crate ties the numerics ([`hgym_solvers`]) to learning ([`hgym_agents`]): flow set-ups
 //! and the one function that builds their solvers ([`flow`]), flow environments ([`env`]),
-//! training, evaluation and comparison protocols ([`train`]), trajectory files ([`data`]),
+//! training, evaluation and comparison protocols ([`train`]), transfer between flows ([`transfer`]), trajectory files ([`data`]),
 //! validation against the literature ([`validate`]) and of each environment's own flow
 //! ([`fidelity`]), plots, reports and the leaderboard ([`report`]), speed benchmarks
 //! ([`bench`]). The binary `hgym` is a thin command line over these modules (`src/main.rs`,
@@ -19,4 +19,5 @@ pub mod fidelity;
 pub mod flow;
 pub mod report;
 pub mod train;
+pub mod transfer;
 pub mod validate;

@@ -74,6 +74,13 @@ enum Command {
     /// Run a comparison protocol (benchmarks/protocols/*.toml): several algorithms over the same
     /// seeds, and the samples each needs to reach a fraction of the reference's final return.
     Compare(cli::train::CompareArgs),
+    /// Transfer a controller between flows (benchmarks/protocols/transfer/): over the same seeds,
+    /// the source policy zero-shot on the target, fine-tuned from it, and trained from scratch;
+    /// episodes and core-hours to 90 % of the from-scratch performance, the saving, a plot.
+    ///
+    /// `hgym transfer Cylinder_2D_Re200 Cylinder_2D_Re1000` (`--list` shows the pairs). Every arm
+    /// is an ordinary run folder: Ctrl-C and the same command again continue where it stopped.
+    Transfer(cli::transfer::TransferArgs),
     /// Trajectory files: `hgym data recover FILE` salvages every complete chunk of a truncated
     /// MCAP file (e.g. after a kill) into FILE.recovered.mcap.
     #[command(subcommand)]
@@ -116,6 +123,7 @@ fn main() -> ExitCode {
         Command::Train(args) => cli::train::run_train(args),
         Command::Eval(args) => cli::train::run_eval(args),
         Command::Compare(args) => cli::train::run_compare(args),
+        Command::Transfer(args) => cli::transfer::run(args),
         Command::Export(args) => cli::data::run_export(args),
         Command::Push(args) => cli::data::run_push(args),
         Command::Data(cmd) => cli::data::run_data(cmd),
@@ -150,6 +158,9 @@ fn is_bad_input(e: &anyhow::Error) -> bool {
             || c.downcast_ref::<hgym::train::TrainError>().is_some_and(|t| t.is_bad_input())
             || c.downcast_ref::<hgym::train::checkpoint::CheckpointError>()
                 .is_some_and(|t| t.is_bad_input())
+            || c.downcast_ref::<hgym::transfer::TransferError>().is_some_and(|t| t.is_bad_input())
+            || c.downcast_ref::<hgym::transfer::compare::CompareError>()
+                .is_some_and(|t| matches!(t, hgym::transfer::compare::CompareError::Invalid { .. }))
             || c.downcast_ref::<hgym::train::compare::CompareError>()
                 .is_some_and(|t| t.is_bad_input())
             || matches!(c.downcast_ref::<hgym::data::DataError>(), Some(hgym::data::DataError::Format(_)))

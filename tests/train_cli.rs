@@ -152,8 +152,11 @@ fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     let t = text(&o);
-    assert!(t.contains("1 action") || t.contains("to 1 actions"), "{t}");
-    assert!(t.contains("3 actions"), "{t}");
+    // The layouts differ (probe positions, actuators): both are named.
+    assert!(
+        t.contains("actuators jet_pair") && t.contains("actuators rotation0, rotation1, rotation2"),
+        "{t}"
+    );
 }
 
 #[test]

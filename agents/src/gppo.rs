@@ -117,4 +117,8 @@ impl Learner for Gppo {
     fn to_bytes(&self) -> Result<Vec<u8>, LearnError> {
         encode(self)
     }
+
+    fn init_actor(&mut self, policy: &ActorPolicy) -> Result<(), LearnError> {
+        self.ppo.init_actor(policy)
+    }
 }

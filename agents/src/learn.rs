@@ -16,6 +16,7 @@ use thiserror::Error;
 use crate::env::{DifferentiableEnv, EnvError};
 use crate::policy::ActorPolicy;
 use crate::rollout::EpisodeStats;
+use crate::transplant::{Parts, SpaceMap};
 
 /// Every algorithm `train` knows, in listing order.
 pub const ALGORITHMS: &[&dyn Algorithm] = &[
@@ -83,6 +84,18 @@ pub trait Learner: Send {
     fn rounds(&self) -> u64;
     /// The whole state as bytes (bincode), for checkpoints.
     fn to_bytes(&self) -> Result<Vec<u8>, LearnError>;
+    /// Starts from a trained policy already mapped onto this learner's spaces (`--init-from`):
+    /// its network becomes the actor (and the actor's target), its observation statistics the
+    /// learner's; optimiser state starts fresh. An error names what does not fit.
+    fn init_actor(&mut self, policy: &ActorPolicy) -> Result<(), LearnError>;
+    /// Also takes the critics of `source` (bytes of a learner of this algorithm, as
+    /// [`Learner::to_bytes`] wrote them), mapped by `map`, and with `parts.buffer` its replay
+    /// buffer. Only off-policy learners have these.
+    fn init_critics(&mut self, _source: &[u8], _map: &SpaceMap, _parts: Parts) -> Result<(), LearnError> {
+        Err(LearnError::Init(
+            "this algorithm is on-policy: it keeps no critics or replay buffer to carry over (they are for td3 and ddpg)".into(),
+        ))
+    }
 }
 
 impl dyn Learner {
@@ -186,6 +199,9 @@ pub enum LearnError {
     Decode(String),
     #[error("the learner's state could not be encoded: {0}")]
     Encode(String),
+    /// A starting point (`--init-from`) that does not fit this learner.
+    #[error("{0}")]
+    Init(String),
 }
 
 #[cfg(test)]

@@ -28,6 +28,7 @@ pub mod rollout;
 mod spaces;
 pub mod td3;
 pub mod toy;
+pub mod transplant;
 
 pub use check::{check_env, Violation};
 pub use env::{checked_action, DifferentiableEnv, Env, EnvError, Info, StepResult};

@@ -173,6 +173,24 @@ impl Ppo {
         ActorPolicy::new("ppo", self.actor.clone(), self.cfg.norm_obs.then(|| self.obs_rms.clone()), 10.0)
     }
 
+    /// Starts from `policy` (see [`Learner::init_actor`]); its normalisation must match `norm_obs`.
+    pub fn init_actor(&mut self, policy: &ActorPolicy) -> Result<(), LearnError> {
+        crate::transplant::fits(policy, &self.actor, &["ppo"])?;
+        match (&policy.obs_norm, self.cfg.norm_obs) {
+            (Some(n), true) => self.obs_rms = n.clone(),
+            (None, false) => {}
+            (n, norm) => {
+                return Err(LearnError::Init(format!(
+                    "the policy {} its observations and this learner has norm_obs = {norm}: set [ppo] norm_obs = {}",
+                    if n.is_some() { "normalises" } else { "does not normalise" },
+                    n.is_some()
+                )))
+            }
+        }
+        self.actor = policy.net.clone();
+        Ok(())
+    }
+
     pub fn log_std(&self) -> &[f32] {
         &self.log_std
     }
@@ -472,5 +490,9 @@ impl Learner for Ppo {
 
     fn to_bytes(&self) -> Result<Vec<u8>, LearnError> {
         encode(self)
+    }
+
+    fn init_actor(&mut self, policy: &ActorPolicy) -> Result<(), LearnError> {
+        Ppo::init_actor(self, policy)
     }
 }

@@ -18,6 +18,7 @@ use crate::noise::OrnsteinUhlenbeck;
 use crate::policy::ActorPolicy;
 use crate::rng::Rng;
 use crate::rollout::{episode_seed, reset_all, step_all, EpisodeAccumulator, EpisodeStats};
+use crate::transplant::{Parts, SpaceMap};
 
 /// TD3 hyperparameters. Defaults: the paper's stated values (sigma 0.2 clipped at 0.5, delay 2,
 /// tau 0.005, batch 256, 256x256 networks, replay 1e5), the rest from CleanRL's `td3_continuous_action`
@@ -382,5 +383,120 @@ impl Learner for Td3 {
 
     fn to_bytes(&self) -> Result<Vec<u8>, LearnError> {
         encode(self)
+    }
+
+    fn init_actor(&mut self, policy: &ActorPolicy) -> Result<(), LearnError> {
+        crate::transplant::fits(policy, &self.actor, &[self.name.as_str()])?;
+        if policy.obs_norm.is_some() {
+            return Err(LearnError::Init(format!(
+                "{} reads raw observations; the policy normalises its own",
+                self.name
+            )));
+        }
+        self.actor = policy.net.clone();
+        self.actor_target = policy.net.clone();
+        Ok(())
+    }
+
+    /// The source's critics (and targets) through [`SpaceMap::critic`]; its replay buffer only
+    /// between environments of one layout (a transition of another layout has no value for the
+    /// target's unmapped observations).
+    fn init_critics(&mut self, source: &[u8], map: &SpaceMap, parts: Parts) -> Result<(), LearnError> {
+        let src: Td3 = decode(source)?;
+        if src.name != self.name || src.critics.len() != self.critics.len() {
+            return Err(LearnError::Init(format!(
+                "the source learner is {} with {} critics, this one {} with {}",
+                src.name,
+                src.critics.len(),
+                self.name,
+                self.critics.len()
+            )));
+        }
+        for (mine, theirs) in self.critics.iter_mut().zip(&src.critics) {
+            let (net, target) = (map.critic(&theirs.net), map.critic(&theirs.target));
+            if net.sizes != mine.net.sizes {
+                return Err(LearnError::Init(format!(
+                    "the source critic maps to layers {:?}, this learner's critic has {:?}: give it the source's hidden sizes",
+                    net.sizes, mine.net.sizes
+                )));
+            }
+            mine.net = net;
+            mine.target = target;
+        }
+        if parts.buffer {
+            if !map.is_identity() {
+                return Err(LearnError::Init(
+                    "the replay buffer carries over only between environments of one observation and action layout".into(),
+                ));
+            }
+            self.buffer = src.buffer;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `--init-from` with critics: the actor and both critics (with targets) arrive mapped, the
+    /// buffer only under the identity map, and a foreign network is refused by name.
+    #[test]
+    fn init_takes_the_actor_critics_and_buffer() {
+        let cfg = Td3Config {
+            hidden: vec![8, 8],
+            ..Td3Config::default()
+        };
+        let mut src = Td3::new("td3", cfg.clone(), 3, 1, 1);
+        src.remember(&[0.1, 0.2, 0.3], &[0.5], -1.0, &[0.2, 0.3, 0.4], false);
+        let bytes = encode(&src).unwrap();
+        let mut dst = Td3::new("td3", cfg.clone(), 3, 1, 2);
+        Learner::init_actor(&mut dst, &src.policy()).unwrap();
+        dst.init_critics(
+            &bytes,
+            &SpaceMap::identity(3, 1),
+            Parts {
+                critics: true,
+                buffer: true,
+            },
+        )
+        .unwrap();
+        assert_eq!(
+            (dst.actor.clone(), dst.actor_target.clone()),
+            (src.actor.clone(), src.actor.clone())
+        );
+        for (a, b) in dst.critics.iter().zip(&src.critics) {
+            assert_eq!((&a.net, &a.target), (&b.net, &b.target));
+        }
+        assert_eq!(encode(&dst.buffer).unwrap(), encode(&src.buffer).unwrap());
+
+        let fan_out = SpaceMap {
+            target_obs_dim: 4,
+            obs: vec![1, 2, 3],
+            source_act_dim: 1,
+            act: vec![Some((0, 1.0)), Some((0, -1.0))],
+        };
+        let mut wide = Td3::new("td3", cfg.clone(), 4, 2, 3);
+        let e = wide
+            .init_critics(
+                &bytes,
+                &fan_out,
+                Parts {
+                    critics: true,
+                    buffer: true,
+                },
+            )
+            .unwrap_err();
+        assert!(e.to_string().contains("one observation and action layout"), "{e}");
+        let mut ddpg = Td3::new("ddpg", cfg.clone(), 3, 1, 4);
+        assert!(Learner::init_actor(&mut ddpg, &src.policy())
+            .unwrap_err()
+            .to_string()
+            .contains("--algo td3"));
+        let mut small = Td3::new("td3", Td3Config { hidden: vec![4], ..cfg }, 3, 1, 5);
+        assert!(Learner::init_actor(&mut small, &src.policy())
+            .unwrap_err()
+            .to_string()
+            .contains("hidden sizes"));
     }
 }

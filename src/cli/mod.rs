@@ -1,5 +1,5 @@
 //! One file per command (its clap arguments and its `run`): `validate`, `bench`, `envs`, `run`,
-//! `train`/`eval`/`compare`, `export`/`push`/`data`, `plot`/`leaderboard`; progress reports for
+//! `train`/`eval`/`compare`, `transfer`, `export`/`push`/`data`, `plot`/`leaderboard`; progress reports for
 //! long runs; standard output that survives a closed pipe.
 
 pub mod bench;
@@ -10,4 +10,5 @@ pub mod plot;
 pub mod progress;
 pub mod run;
 pub mod train;
+pub mod transfer;
 pub mod validate;

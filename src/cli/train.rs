@@ -8,10 +8,13 @@ use clap::Args;
 use hgym::flow::Level;
 use hgym::train::config::TrainConfig;
 use hgym::train::eval::{evaluate, parse_policy, uncontrolled_c_d, EvalReport, NamedPolicy};
-use hgym::train::{resolve_spec, resume_options, summarize, Ending, TrainError, TrainOptions};
+use hgym::train::{resolve_spec, resume_options, summarize, Ending, Init, TrainError, TrainOptions};
+use hgym::transfer::mapping::MappingSpec;
+use hgym::transfer::{load_mapping, SourceRun, TransferError};
 use hgym_agents::baselines::BaselinePolicy;
 use hgym_agents::learn::{algorithm, ALGORITHMS};
 use hgym_agents::policy::Policy;
+use hgym_agents::transplant::Parts;
 
 use crate::cli::progress::progress_bar;
 use crate::{thread_pool, Outcome, UsageError};
@@ -30,9 +33,9 @@ pub struct TrainArgs {
     /// Environment ID (`hgym envs` lists them), e.g. Cylinder_2D_Re100.
     #[arg(long, required_unless_present_any = ["resume", "print_config"])]
     env: Option<String>,
-    /// Learning algorithm.
-    #[arg(long, default_value = "td3", value_parser = algo_names())]
-    algo: String,
+    /// Learning algorithm [default: td3, or the --init-from run's].
+    #[arg(long, value_parser = algo_names())]
+    algo: Option<String>,
     /// Seed of the learner and of every episode's initial phase.
     #[arg(long, default_value_t = 0, conflicts_with = "seeds")]
     seed: u64,
@@ -48,12 +51,27 @@ pub struct TrainArgs {
     /// TOML file overriding the defaults: [train], [ppo], [ddpg], [td3], [env] (see --print-config).
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Where result folders go: <out>/<ID>-<algo>-<level>/seed<S>/.
+    /// Where result folders go: <out>/<ID>-<algo>-<level>/seed<S>/ (fine-tuning: <ID>-<algo>-<level>-from-<SOURCE>-seed<S>/).
     #[arg(long, default_value = "results/train")]
     out: PathBuf,
     /// Continue a run (killed or finished) from its folder's checkpoint; --steps may raise the budget.
-    #[arg(long, conflicts_with_all = ["env", "seeds", "config"])]
+    #[arg(long, conflicts_with_all = ["env", "seeds", "config", "init_from"])]
     resume: Option<PathBuf>,
+    /// Fine-tune: start from the policy of a finished run folder (trained on --env or another
+    /// flow: probes are matched by position, actuators by name, see --mapping). Its first
+    /// evaluation (curve row 0) is the source policy's zero-shot evaluation.
+    #[arg(long, value_name = "DIR")]
+    init_from: Option<PathBuf>,
+    /// A TOML file whose [mapping] table maps the source run's actuators onto --env's (e.g. a
+    /// protocol in benchmarks/protocols/transfer/); needed when actuator names differ.
+    #[arg(long, value_name = "FILE", requires = "init_from")]
+    mapping: Option<PathBuf>,
+    /// Also start from the source run's critics (td3, ddpg; needs its checkpoint.bin).
+    #[arg(long, requires = "init_from")]
+    init_critics: bool,
+    /// Also start from the source run's replay buffer (td3, ddpg; same layouts only; implies --init-critics).
+    #[arg(long, requires = "init_from")]
+    init_buffer: bool,
     /// Print the effective configuration as TOML and exit.
     #[arg(long)]
     print_config: bool,
@@ -70,9 +88,14 @@ pub struct EvalArgs {
     /// constant=v, opposition[=gain] (a = -gain C_L), pd=SIGNAL,kp,kd (SIGNAL: obs:i or an info key).
     #[arg(long)]
     policy: String,
-    /// Environment ID; a policy trained on another flow works if the observation and action sizes match.
+    /// Environment ID. A run folder trained on another flow is mapped onto it (zero-shot
+    /// transfer): probes by position relative to the body, actuators by name or --mapping.
     #[arg(long)]
     env: String,
+    /// A TOML file whose [mapping] table maps the run's actuators onto --env's (e.g. a protocol
+    /// in benchmarks/protocols/transfer/).
+    #[arg(long, value_name = "FILE")]
+    mapping: Option<PathBuf>,
     /// Episodes to evaluate (1 to 100000).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     episodes: u64,
@@ -148,6 +171,55 @@ fn parse_seeds(text: &str) -> Result<Vec<u64>> {
     Ok(seeds)
 }
 
+fn transfer_error(e: TransferError) -> anyhow::Error {
+    if e.is_bad_input() {
+        UsageError(e.to_string()).into()
+    } else {
+        anyhow::Error::new(e)
+    }
+}
+
+/// `--init-from`: the source run's policy mapped onto `spec` by `mapping`,
+/// and with `critics`/`buffer` its learner's checkpoint. Warns when the source's spec is stale.
+pub fn init_from(src: &SourceRun, spec: &hgym::env::Spec, mapping: &MappingSpec, critics: bool, buffer: bool) -> Result<Init> {
+    if src.stale() {
+        eprintln!(
+            "warning: {} was trained on spec {} of {}, which is no longer the registered one ({}); its layout is read from today's",
+            src.dir.display(),
+            &src.spec_hash[..8.min(src.spec_hash.len())],
+            src.env_id,
+            &src.spec.hash()[..8]
+        );
+    }
+    let (map, policy) = src.onto(spec, mapping).map_err(transfer_error)?;
+    let parts = Parts {
+        critics: critics || buffer,
+        buffer,
+    };
+    let learner = if parts.critics {
+        let ck = hgym::train::checkpoint::load(&src.dir).map_err(|e| {
+            UsageError(format!(
+                "--init-critics needs the source run's checkpoint: {} (checkpoints stay on the machine that trained; rerun the source or drop the flag)",
+                hgym::report::chain(&e)
+            ))
+        })?;
+        Some((ck.learner, map.clone()))
+    } else {
+        None
+    };
+    Ok(Init {
+        record: src.record(mapping, &map, parts.critics, parts.buffer),
+        policy,
+        learner,
+        parts,
+    })
+}
+
+/// The `[mapping]` table of `--mapping FILE` (the default mapping without one).
+fn mapping(file: Option<&Path>) -> Result<MappingSpec> {
+    Ok(file.map(load_mapping).transpose().map_err(transfer_error)?.unwrap_or_default())
+}
+
 fn train_error(e: TrainError) -> anyhow::Error {
     match e {
         TrainError::Input(m) => UsageError(m).into(),
@@ -180,8 +252,24 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
         vec![(opts, Some(ck))]
     } else {
         let env_id = args.env.clone().unwrap_or_default();
-        let algo = algorithm(&args.algo).map_err(|e| UsageError(e.to_string()))?;
         let spec = resolve_spec(&env_id, &config).map_err(train_error)?;
+        let source = args.init_from.as_deref().map(SourceRun::load).transpose().map_err(transfer_error)?;
+        let algo_name = args
+            .algo
+            .clone()
+            .or_else(|| source.as_ref().map(|s| s.algo.clone()))
+            .unwrap_or_else(|| "td3".into());
+        let algo = algorithm(&algo_name).map_err(|e| UsageError(e.to_string()))?;
+        let init = match &source {
+            Some(src) => Some(init_from(
+                src,
+                &spec,
+                &mapping(args.mapping.as_deref())?,
+                args.init_critics,
+                args.init_buffer,
+            )?),
+            None => None,
+        };
         if algo.needs_gradients() && !spec.differentiable() {
             return Err(UsageError(format!(
                 "{} needs a differentiable environment (the Kolmogorov flows, e.g. Kolmogorov_2D_Re40); \
@@ -195,7 +283,11 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
             Some(s) => parse_seeds(s)?,
             None => vec![args.seed],
         };
-        let root = args.out.join(format!("{env_id}-{}-{}", algo.name(), args.level.name()));
+        let from = source
+            .as_ref()
+            .map(|s| format!("-from-{}-seed{}", s.env_id, s.seed))
+            .unwrap_or_default();
+        let root = args.out.join(format!("{env_id}-{}-{}{from}", algo.name(), args.level.name()));
         seeds
             .iter()
             .map(|s| {
@@ -208,6 +300,7 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
                         config: config.clone(),
                         out: root.join(format!("seed{s}")),
                         cache: cache.clone(),
+                        init: init.clone(),
                     },
                     None,
                 )
@@ -335,6 +428,13 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
     let spec = resolve_spec(&args.env, &config).map_err(train_error)?;
     let named = parse_policy(&args.policy)?;
     let (mut policy, name): (Box<dyn Policy + Send>, String) = match named {
+        NamedPolicy::Trained(_) if Path::new(&args.policy).join("manifest.json").exists() => {
+            // A run folder: its environment's layout maps the policy onto this one.
+            let src = SourceRun::load(Path::new(&args.policy)).map_err(transfer_error)?;
+            let init = init_from(&src, &spec, &mapping(args.mapping.as_deref())?, false, false)?;
+            let name = format!("{} ({})", src.algo, args.policy);
+            (Box::new(init.policy), name)
+        }
         NamedPolicy::Trained(p) => {
             if p.obs_dim() != spec.obs_dim() || p.act_dim() != spec.act_dim() {
                 return Err(UsageError(format!(
@@ -538,6 +638,7 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
                     config: p.config.clone(),
                     out: dir.clone(),
                     cache: hgym::env::default_cache_dir(),
+                    init: None,
                 };
                 let label = format!("{algo} s{seed}");
                 let pb = progress_bar(p.config.train.steps, &label);
@@ -565,7 +666,7 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
             }
         }
     }
-    let r0 = pool.install(|| uncontrolled_return(&p))?;
+    let r0 = pool.install(|| uncontrolled_return(&p.env, p.level, &p.config))?;
     let cmp = analyse(&p, &root, r0)?;
     std::fs::create_dir_all(&root)?;
     std::fs::write(root.join("comparison.json"), serde_json::to_string_pretty(&cmp)? + "\n")?;

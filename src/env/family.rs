@@ -43,6 +43,11 @@ pub trait FamilySpec: Any + Send + Sync + std::fmt::Debug {
     fn act_dim(&self) -> usize;
     /// Physical time between actions.
     fn control_interval(&self) -> f64;
+    /// What each observation and action means (for transfer between environments); by default
+    /// they are known by index.
+    fn layout(&self) -> super::layout::Layout {
+        super::layout::Layout::indexed(self.obs_dim(), self.act_dim())
+    }
     /// Whether [`DifferentiableEnv::reward_action_gradients`] works on its environments.
     fn differentiable(&self) -> bool {
         false

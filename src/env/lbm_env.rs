@@ -669,6 +669,10 @@ impl FamilySpec for EnvSpec {
         self.control_interval
     }
 
+    fn layout(&self) -> super::layout::Layout {
+        super::layout::Layout::of(self)
+    }
+
     fn calibrated(&self) -> bool {
         !self.normalization.mean.is_empty()
     }

@@ -7,6 +7,7 @@
 //! - [`spec`]: the serialisable description of a lattice-Boltzmann environment (its hash keys
 //!   caches and results); [`lbm_env`]: its `Env` implementation;
 //! - [`actuation`]: jets, rotation, and the temporal smoothing of actions;
+//! - [`layout`]: what each observation and action means (probe positions, actuator names), for transfer;
 //! - [`spin_up`]: progress reports of the first reset's spin-up, to an observer the program installs.
 
 pub mod actuation;
@@ -16,6 +17,7 @@ pub mod cylinder;
 pub mod family;
 pub mod fields;
 pub mod kolmogorov;
+pub mod layout;
 pub mod lbm_env;
 pub mod naca;
 pub mod pinball;

@@ -116,12 +116,12 @@ pub struct Comparison {
     pub sample_reduction_vs_reference: Vec<(String, f64)>,
 }
 
-/// Return of the zero policy on the protocol's evaluation episodes.
-pub fn uncontrolled_return(p: &Protocol) -> Result<f64, super::TrainError> {
-    let spec = super::resolve_spec(&p.env, &p.config)?;
-    let mut env = spec.make(p.level, crate::env::default_cache_dir())?;
-    let n = p.config.train.eval_episodes.max(1);
-    let seeds: Vec<u64> = (0..n as u64).map(|k| p.config.train.eval_seed + k).collect();
+/// Return of the zero policy on the periodic evaluation episodes of `config` on `env_id`.
+pub fn uncontrolled_return(env_id: &str, level: Level, config: &TrainConfig) -> Result<f64, super::TrainError> {
+    let spec = super::resolve_spec(env_id, config)?;
+    let mut env = spec.make(level, crate::env::default_cache_dir())?;
+    let n = config.train.eval_episodes.max(1);
+    let seeds: Vec<u64> = (0..n as u64).map(|k| config.train.eval_seed + k).collect();
     let mut zero = hgym_agents::baselines::BaselinePolicy::new(hgym_agents::baselines::Baseline::Zero, 0);
     let refs = vec![f64::NAN; n];
     let hash = spec.hash();
@@ -131,7 +131,7 @@ pub fn uncontrolled_return(p: &Protocol) -> Result<f64, super::TrainError> {
         "zero",
         spec.id(),
         &hash,
-        p.level.name(),
+        level.name(),
         &seeds,
         &refs,
         None,
@@ -140,7 +140,8 @@ pub fn uncontrolled_return(p: &Protocol) -> Result<f64, super::TrainError> {
     Ok(r.ret.mean)
 }
 
-fn final_eval(rows: &[CurveRow]) -> f64 {
+/// The last evaluation return of a learning curve (NaN if none).
+pub fn final_eval(rows: &[CurveRow]) -> f64 {
     rows.iter()
         .rev()
         .find(|r| r.eval_return.is_finite())
@@ -216,8 +217,7 @@ pub fn analyse(p: &Protocol, root: &Path, r0: f64) -> Result<Comparison, Compare
     Ok(cmp)
 }
 
-/// Mean +- std over seeds of each algorithm's evaluation return against samples (evaluations
-/// happen at the same sample counts for every seed of an algorithm).
+/// Mean +- std over seeds of each algorithm's evaluation return against samples.
 fn plot(
     p: &Protocol,
     curves: &[(String, u64, PathBuf, Vec<CurveRow>, f64)],
@@ -225,12 +225,35 @@ fn plot(
     r0: f64,
     path: &Path,
 ) -> Result<(), crate::report::plots::PlotError> {
+    let groups: Vec<(String, Vec<&[CurveRow]>)> = p
+        .algos
+        .iter()
+        .map(|a| (a.clone(), curves.iter().filter(|c| c.0 == *a).map(|c| &c.3[..]).collect()))
+        .collect();
+    let hlines = [
+        (
+            format!("threshold ({:.0} % of the reference's gain)", 100.0 * p.fraction),
+            threshold,
+        ),
+        ("uncontrolled".to_string(), r0),
+    ];
+    curve_plot(path, &format!("{}: {} ({})", p.name, p.env, p.level.name()), &groups, &hlines)
+}
+
+/// Learning curves of several groups of runs, each as the mean +- std over its runs of the
+/// evaluation return against samples (a group's runs evaluate at the same sample counts), and
+/// horizontal lines across the whole span.
+pub fn curve_plot(
+    path: &Path,
+    title: &str,
+    groups: &[(String, Vec<&[CurveRow]>)],
+    hlines: &[(String, f64)],
+) -> Result<(), crate::report::plots::PlotError> {
     let mut xs: Vec<Vec<f64>> = vec![];
     let mut ys: Vec<Vec<f64>> = vec![];
     let mut bands: Vec<Vec<f64>> = vec![];
     let mut labels: Vec<String> = vec![];
-    for algo in &p.algos {
-        let runs: Vec<&Vec<CurveRow>> = curves.iter().filter(|c| c.0 == *algo).map(|c| &c.3).collect();
+    for (name, runs) in groups {
         let Some(first) = runs.first() else { continue };
         let points: Vec<u64> = first.iter().filter(|r| r.eval_return.is_finite()).map(|r| r.samples).collect();
         let (mut x, mut y, mut b) = (vec![], vec![], vec![]);
@@ -248,13 +271,11 @@ fn plot(
         xs.push(x);
         ys.push(y);
         bands.push(b);
-        labels.push(format!("{} (mean +- std, {} seeds)", algo, runs.len()));
+        labels.push(format!("{} (mean +- std, {} seeds)", name, runs.len()));
     }
     let span = xs.iter().flat_map(|x| x.iter().copied()).fold(0.0, f64::max);
     let hx = [0.0, span];
-    let hy = [threshold, threshold];
-    let zy = [r0, r0];
-    let th_label = format!("threshold ({:.0} % of the reference's gain)", 100.0 * p.fraction);
+    let hy: Vec<[f64; 2]> = hlines.iter().map(|(_, v)| [*v, *v]).collect();
     let mut lines: Vec<plots::Line> = (0..xs.len())
         .map(|k| plots::Line {
             label: &labels[k],
@@ -263,23 +284,13 @@ fn plot(
             band: Some(&bands[k]),
         })
         .collect();
-    lines.push(plots::Line {
-        label: &th_label,
-        x: &hx,
-        y: &hy,
-        band: None,
-    });
-    lines.push(plots::Line {
-        label: "uncontrolled",
-        x: &hx,
-        y: &zy,
-        band: None,
-    });
-    plots::lines(
-        path,
-        &format!("{}: {} ({})", p.name, p.env, p.level.name()),
-        "environment samples",
-        "evaluation return",
-        &lines,
-    )
+    for ((label, _), y) in hlines.iter().zip(&hy) {
+        lines.push(plots::Line {
+            label,
+            x: &hx,
+            y,
+            band: None,
+        });
+    }
+    plots::lines(path, title, "environment samples", "evaluation return", &lines)
 }

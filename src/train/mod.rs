@@ -7,6 +7,10 @@
 //! - `curve.csv`, `curve.png`, `drag_reduction.png`: the learning curve;
 //! - `policy.json`: the final deterministic policy (`hgym eval --policy DIR` loads it);
 //! - `metrics.json`: the final evaluation ([`eval::EvalReport`]);
+//! - `init_from.json`: for a run started from another run's policy (`--init-from`), where it
+//!   started and how the source was mapped (also in the manifest); such a run evaluates its
+//!   starting policy before the first round (curve row 0), which is the source policy's
+//!   zero-shot evaluation;
 //! - `checkpoint.bin`: everything needed to continue (`--resume DIR`): a resumed run reaches the
 //!   same policy and metrics as an uninterrupted one, bitwise, because rounds reset their
 //!   environments from seeds derived from (seed, round) and the learner's state is complete.
@@ -84,7 +88,39 @@ pub struct TrainOptions {
     pub config: TrainConfig,
     pub out: PathBuf,
     pub cache: Option<PathBuf>,
+    /// Start from another run's policy (fresh runs only; a resumed run has it in its checkpoint).
+    pub init: Option<Init>,
 }
+
+/// A starting point for `--init-from`: the source policy mapped onto this environment, and
+/// optionally the source learner's critics and replay buffer.
+#[derive(Clone, Debug)]
+pub struct Init {
+    pub policy: hgym_agents::policy::ActorPolicy,
+    /// The source learner's checkpoint bytes and the map, when `parts` asks for more than the actor.
+    pub learner: Option<(Vec<u8>, hgym_agents::transplant::SpaceMap)>,
+    pub parts: hgym_agents::transplant::Parts,
+    pub record: InitRecord,
+}
+
+/// What a fine-tuning run records about where it started (`init_from.json`, then its manifest).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct InitRecord {
+    pub dir: PathBuf,
+    pub env_id: String,
+    pub spec_hash: String,
+    pub algo: String,
+    pub seed: u64,
+    pub level: String,
+    /// The `[mapping]` table the source was mapped with.
+    pub mapping: serde_json::Value,
+    /// Whether the map was the identity (same layouts).
+    pub identity: bool,
+    pub critics: bool,
+    pub buffer: bool,
+}
+
+pub const INIT_FILE: &str = "init_from.json";
 
 /// What the progress display sees after each round.
 #[derive(Clone, Debug)]
@@ -122,6 +158,9 @@ pub struct TrainManifest {
     pub resumed: u32,
     /// The effective training configuration (as `--print-config` prints it).
     pub config_toml: String,
+    /// The run this one started from (`--init-from`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub init_from: Option<InitRecord>,
     pub manifest: Manifest,
 }
 
@@ -164,9 +203,40 @@ pub fn train(
             (learner, ck.curve, ck.reference, ck.wall_s, ck.resumed + 1)
         }
         None => {
-            let learner = algo.learner(&config.algos, obs_dim, act_dim, opts.seed)?;
+            let mut learner = algo.learner(&config.algos, obs_dim, act_dim, opts.seed)?;
             let reference = uncontrolled_c_d(&mut eval_env, &periodic_seeds)?;
-            (learner, vec![], reference, 0.0, 0)
+            let mut curve = vec![];
+            if let Some(init) = &opts.init {
+                learner.init_actor(&init.policy)?;
+                if let Some((bytes, map)) = &init.learner {
+                    learner.init_critics(bytes, map, init.parts)?;
+                }
+                write_json(&opts.out.join(INIT_FILE), "the source run", &init.record)?;
+                let r = evaluate(
+                    &mut eval_env,
+                    &mut learner.policy(),
+                    algo.name(),
+                    spec.id(),
+                    &spec.hash(),
+                    opts.level.name(),
+                    &periodic_seeds,
+                    &reference,
+                    None,
+                    &mut |_| {},
+                )?;
+                curve.push(CurveRow {
+                    round: 0,
+                    samples: 0,
+                    updates: 0,
+                    wall_s: started.elapsed().as_secs_f64(),
+                    train_return: f64::NAN,
+                    train_c_d: f64::NAN,
+                    eval_return: r.ret.mean,
+                    eval_c_d: r.mean_c_d.mean,
+                    eval_drag_reduction_pct: r.drag_reduction_pct.mean,
+                });
+            }
+            (learner, curve, reference, 0.0, 0)
         }
     };
     let config_toml = config.to_toml();
@@ -310,6 +380,7 @@ pub fn train(
         rounds: learner.rounds(),
         resumed,
         config_toml,
+        init_from: read_init(&opts.out)?,
         manifest: manifest(rayon::current_num_threads(), wall),
     };
     write_json(&opts.out.join("manifest.json"), "the manifest", &m)?;
@@ -332,9 +403,25 @@ pub fn resume_options(dir: &Path, steps: Option<u64>, cache: Option<PathBuf>) ->
             config,
             out: dir.to_path_buf(),
             cache,
+            init: None,
         },
         ck,
     ))
+}
+
+/// The run's `init_from.json`, if it started from another run.
+fn read_init(dir: &Path) -> Result<Option<InitRecord>, TrainError> {
+    let path = dir.join(INIT_FILE);
+    if !path.exists() {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(&path).map_err(io(&path))?;
+    serde_json::from_str(&text).map(Some).map_err(|source| {
+        TrainError::Report(crate::report::ReportError::Json {
+            what: path.display().to_string(),
+            source,
+        })
+    })
 }
 
 /// Summary over the seeds of one (env, algorithm): mean and std over seeds of the per-seed

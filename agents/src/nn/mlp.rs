@@ -153,6 +153,52 @@ impl<T: Scalar> Mlp<T> {
         self.sizes[self.sizes.len() - 1]
     }
 
+    /// The network with its first layer's inputs and its last layer's outputs remapped (for
+    /// transfer between environments of other layouts): new input `c` of the first layer has
+    /// the weights `sum_{(i, w) in inputs[c]} w W[:, i]`, new output `k` of the last layer has the
+    /// weights and bias `s W[j, :]`, `s b[j]` for `outputs[k] = Some((j, s))`, and zeros for `None`.
+    /// Indices must be below the old input and output sizes.
+    pub fn remapped(&self, inputs: &[Vec<(usize, T)>], outputs: &[Option<(usize, T)>]) -> Mlp<T> {
+        let mut sizes = self.sizes.clone();
+        let last = self.layers() - 1;
+        sizes[0] = inputs.len();
+        sizes[last + 1] = outputs.len();
+        let n: usize = sizes.windows(2).map(|w| w[0] * w[1] + w[1]).sum();
+        let mut net = Mlp {
+            sizes,
+            hidden: self.hidden,
+            output: self.output,
+            params: vec![T::ZERO; n],
+        };
+        for l in 0..self.layers() {
+            let (wo, bo) = self.offsets(l);
+            let (nwo, nbo) = net.offsets(l);
+            let (n_in, n_in_new, n_out_new) = (self.sizes[l], net.sizes[l], net.sizes[l + 1]);
+            for r in 0..n_out_new {
+                let (row, sign) = match (l == last, outputs.get(r)) {
+                    (true, Some(Some((j, s)))) => (*j, *s),
+                    (true, _) => continue,
+                    (false, _) => (r, T::ONE),
+                };
+                let w = |i: usize| self.params[wo + row * n_in + i];
+                let new_row = &mut net.params[nwo + r * n_in_new..nwo + (r + 1) * n_in_new];
+                for (c, out) in new_row.iter_mut().enumerate() {
+                    let v = if l == 0 {
+                        inputs[c].iter().fold(None, |acc: Option<T>, (i, g)| {
+                            let t = *g * w(*i);
+                            Some(acc.map_or(t, |a| a + t))
+                        })
+                    } else {
+                        Some(w(c))
+                    };
+                    *out = v.map_or(T::ZERO, |v| sign * v);
+                }
+                net.params[nbo + r] = sign * self.params[bo + row];
+            }
+        }
+        net
+    }
+
     /// Offsets of layer `l`'s weights and biases in `params`.
     fn offsets(&self, l: usize) -> (usize, usize) {
         let w: usize = self.sizes[..=l].windows(2).map(|w| w[0] * w[1] + w[1]).sum();

@@ -1,0 +1,243 @@
+//! `hgym transfer`: a transfer protocol's three arms over its seeds, then their comparison.
+
+use std::path::PathBuf;
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use hgym::train::eval::{evaluate, uncontrolled_c_d};
+use hgym::train::{checkpoint, resolve_spec, Ending, TrainOptions};
+use hgym::transfer::protocol::{Protocol, ARMS};
+use hgym::transfer::SourceRun;
+
+use crate::cli::progress::progress_bar;
+use crate::cli::train::{init_from, install_interrupt, INTERRUPTED};
+use crate::{thread_pool, Outcome, UsageError};
+
+#[derive(Args)]
+pub struct TransferArgs {
+    /// Source environment (ID or the protocol's short name), e.g. Cylinder_2D_Re200.
+    #[arg(required_unless_present_any = ["protocol", "list"], requires = "target")]
+    source: Option<String>,
+    /// Target environment, e.g. Cylinder_2D_Re1000.
+    target: Option<String>,
+    /// Any protocol file instead of a bundled pair (see benchmarks/protocols/transfer/).
+    #[arg(long, conflicts_with_all = ["source", "list"])]
+    protocol: Option<PathBuf>,
+    /// List the bundled protocols and exit.
+    #[arg(long)]
+    list: bool,
+    /// Where the arms and the comparison go: <out>/<name>/{zeroshot,finetune,scratch}/seed<S>/,
+    /// comparison.json, transfer.png.
+    #[arg(long, default_value = "results/transfer")]
+    out: PathBuf,
+    /// Only recompute the comparison from finished arms.
+    #[arg(long)]
+    analyse_only: bool,
+    #[arg(long)]
+    json: bool,
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+fn usage(e: impl std::fmt::Display) -> anyhow::Error {
+    UsageError(e.to_string()).into()
+}
+
+pub fn run(args: TransferArgs) -> Result<Outcome> {
+    if args.list {
+        println!("{}", Protocol::listing());
+        return Ok(Outcome::Ok);
+    }
+    let p = match (&args.protocol, &args.source, &args.target) {
+        (Some(file), _, _) => Protocol::load(file).map_err(usage)?,
+        (None, Some(s), Some(t)) => Protocol::find(s, t).map_err(usage)?,
+        _ => return Err(usage("give SOURCE TARGET, --protocol FILE or --list")),
+    };
+    let root = args.out.join(&p.name);
+    std::fs::create_dir_all(&root).with_context(|| format!("cannot create {}", root.display()))?;
+    let config_file = root.join("train.toml");
+    std::fs::write(&config_file, p.config.to_toml()).with_context(|| format!("cannot write {}", config_file.display()))?;
+    let target = resolve_spec(&p.target, &p.config).map_err(usage)?;
+    resolve_spec(&p.source, &p.config).map_err(usage)?;
+    let mut sources = vec![];
+    for &seed in &p.seeds {
+        let dir = p.source_dir(seed);
+        if !dir.join("policy.json").exists() {
+            return Err(usage(format!(
+                "{}: the source run of seed {seed} is missing ({}); make the source runs with:\n  {}",
+                p.name,
+                dir.display(),
+                p.source_command(&config_file)
+            )));
+        }
+        let src = SourceRun::load(&dir).map_err(usage)?;
+        if src.spec_hash != p.source_spec_hash || src.env_id != p.source || src.algo != p.algo {
+            return Err(usage(format!(
+                "{}: {} is {} {} on spec {}, the protocol's source is {} {} on spec {}; retrain it with:\n  {}",
+                p.name,
+                dir.display(),
+                src.env_id,
+                src.algo,
+                &src.spec_hash[..8.min(src.spec_hash.len())],
+                p.source,
+                p.algo,
+                &p.source_spec_hash[..8.min(p.source_spec_hash.len())],
+                p.source_command(&config_file)
+            )));
+        }
+        sources.push(src);
+    }
+    let (pool, threads) = thread_pool(args.threads)?;
+    install_interrupt();
+    if !args.analyse_only {
+        let total = ARMS.len() * p.seeds.len();
+        let mut k = 0;
+        for arm in ARMS {
+            for (src, &seed) in sources.iter().zip(&p.seeds) {
+                k += 1;
+                let dir = p.arm_dir(&root, arm, seed);
+                let label = format!("{arm} s{seed} ({k}/{total})");
+                if dir.join("metrics.json").exists() {
+                    eprintln!("{label}: done already ({})", dir.display());
+                    continue;
+                }
+                if arm == "zeroshot" {
+                    pool.install(|| zeroshot(&p, src, &target, &dir, threads))?;
+                    eprintln!("{label}: evaluated ({})", dir.display());
+                    continue;
+                }
+                let resume = if dir.join(checkpoint::FILE).exists() {
+                    Some(checkpoint::load(&dir)?)
+                } else {
+                    None
+                };
+                let init = match (arm, &resume) {
+                    ("finetune", None) => Some(init_from(src, &target, &p.mapping, false, false)?),
+                    _ => None,
+                };
+                let opts = TrainOptions {
+                    env_id: p.target.clone(),
+                    algo: p.algo.clone(),
+                    seed,
+                    level: p.level,
+                    config: p.config.clone(),
+                    out: dir.clone(),
+                    cache: hgym::env::default_cache_dir(),
+                    init,
+                };
+                let pb = progress_bar(p.config.train.steps, &label);
+                let ending = pool
+                    .install(|| {
+                        hgym::train::train(
+                            &opts,
+                            resume,
+                            &mut |pr| {
+                                pb.set_position(pr.samples.min(pr.total));
+                                if pb.is_hidden() && pr.round % 20 == 0 {
+                                    eprintln!("{label}: {} / {} samples, return {:.2}", pr.samples, pr.total, pr.train_return);
+                                }
+                            },
+                            &|| INTERRUPTED.load(Ordering::SeqCst),
+                        )
+                    })
+                    .with_context(|| format!("{label} on {}", p.target))?;
+                pb.finish_and_clear();
+                if let Ending::Interrupted { .. } = ending {
+                    eprintln!("stopped; run the same command again to continue where it stopped");
+                    std::process::exit(130);
+                }
+                eprintln!("{label}: finished ({})", dir.display());
+            }
+        }
+    }
+    let r0 = pool.install(|| hgym::train::compare::uncontrolled_return(&p.target, p.level, &p.config))?;
+    let cmp = hgym::transfer::compare::analyse(&p, &root, r0, episode_actions(&target)?)?;
+    std::fs::write(root.join("comparison.json"), serde_json::to_string_pretty(&cmp)? + "\n")?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&cmp)?);
+        return Ok(Outcome::Ok);
+    }
+    println!(
+        "{}: {} -> {} ({}, {}), seeds {:?}; threshold {:.2} ({:.0} % of scratch's gain over the uncontrolled {:.2})",
+        p.name,
+        p.source,
+        p.target,
+        p.algo,
+        p.level.name(),
+        p.seeds,
+        cmp.threshold,
+        100.0 * p.fraction,
+        cmp.uncontrolled_return
+    );
+    for a in &cmp.arms {
+        println!(
+            "  {:<9} drag reduction {:+6.2} % +- {:.2}   episodes to threshold {:6.1} +- {:.1} ({} of {} seeds)   wall {:6.0} s   {:.2} core-h",
+            a.arm,
+            a.final_drag_reduction_pct.mean,
+            a.final_drag_reduction_pct.std,
+            a.episodes_to_threshold.mean,
+            a.episodes_to_threshold.std,
+            a.seeds_reaching,
+            p.seeds.len(),
+            a.wall_s.mean,
+            a.core_hours
+        );
+    }
+    println!(
+        "  fine-tuning saves {:.0} % of the episodes and {:.0} % of the core-hours to the threshold\n  results: {}",
+        cmp.episode_saving_pct,
+        cmp.cost_saving_pct,
+        root.display()
+    );
+    Ok(Outcome::Ok)
+}
+
+/// Episode length in actions, from the spec.
+fn episode_actions(spec: &hgym::env::Spec) -> Result<usize> {
+    spec.to_json()?["episode_actions"]
+        .as_u64()
+        .map(|n| n as usize)
+        .with_context(|| format!("{} has no episode_actions", spec.id()))
+}
+
+/// The zero-shot arm of one seed: the source policy, mapped, on the target's final evaluation
+/// episodes, written as an `hgym eval --out` folder (metrics.json, manifest.json).
+fn zeroshot(p: &Protocol, src: &SourceRun, target: &hgym::env::Spec, dir: &std::path::Path, threads: usize) -> Result<()> {
+    let started = Instant::now();
+    let init = init_from(src, target, &p.mapping, false, false)?;
+    let mut policy = init.policy;
+    let n = p.config.train.final_eval_episodes.max(1) as u64;
+    let seeds: Vec<u64> = (0..n).map(|k| p.config.train.eval_seed + k).collect();
+    let mut env = target.make(p.level, hgym::env::default_cache_dir())?;
+    let reference = uncontrolled_c_d(&mut env, &seeds)?;
+    let name = format!("{} ({}, zero-shot)", src.algo, src.dir.display());
+    let report = evaluate(
+        &mut env,
+        &mut policy,
+        &name,
+        target.id(),
+        &target.hash(),
+        p.level.name(),
+        &seeds,
+        &reference,
+        None,
+        &mut |_| {},
+    )?;
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let manifest = serde_json::json!({
+        "schema": "hgym/eval-manifest/v1",
+        "env_id": target.id(),
+        "spec_hash": target.hash(),
+        "spec": target,
+        "level": p.level.name(),
+        "policy": src.dir.display().to_string(),
+        "eval_seed": p.config.train.eval_seed,
+        "episodes": n,
+        "manifest": hgym::report::manifest::manifest(threads, started.elapsed().as_secs_f64()),
+    });
+    std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&manifest)? + "\n")?;
+    std::fs::write(dir.join("metrics.json"), serde_json::to_string_pretty(&report)? + "\n")?;
+    Ok(())
+}

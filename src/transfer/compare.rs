@@ -1,0 +1,222 @@
+//! The comparison of a transfer protocol's arms (`comparison.json`, `transfer.png`).
+//!
+//! Performance is measured as in `hgym compare` ([`crate::train::compare`]): the threshold is
+//! `R_0 + fraction (R_scratch - R_0)` with `R_0` the uncontrolled return on the periodic
+//! evaluation episodes and `R_scratch` the from-scratch arm's final periodic evaluation (mean over
+//! seeds); a run reaches it at its first evaluation at or above it. A fine-tuning run evaluates
+//! its starting policy at 0 samples, so a source that is already good enough reaches it at 0.
+//! Final drag reductions and returns are each run's final evaluation (`metrics.json`). Cost is
+//! core-hours: wall time times threads; the cost to threshold scales a run's core-hours by the
+//! fraction of its samples spent before reaching the threshold.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::protocol::Protocol;
+use crate::train::compare::{curve_plot, final_eval};
+use crate::train::curve::{from_csv, CurveRow};
+use crate::train::eval::{EvalReport, Stat};
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ArmRun {
+    pub arm: String,
+    pub seed: u64,
+    pub dir: PathBuf,
+    pub final_drag_reduction_pct: f64,
+    pub final_return: f64,
+    /// Environment samples collected (0 for the zero-shot arm).
+    pub samples: u64,
+    pub samples_to_threshold: Option<u64>,
+    pub wall_s: f64,
+    pub core_hours: f64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ArmSummary {
+    pub arm: String,
+    pub final_drag_reduction_pct: Stat,
+    pub final_return: Stat,
+    /// Over the seeds that reach the threshold.
+    pub samples_to_threshold: Stat,
+    pub episodes_to_threshold: Stat,
+    pub seeds_reaching: usize,
+    pub wall_s: Stat,
+    /// Summed over seeds.
+    pub core_hours: f64,
+    /// Mean over the seeds that reach the threshold.
+    pub core_hours_to_threshold: Stat,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct TransferComparison {
+    pub schema: String,
+    pub protocol: Protocol,
+    pub uncontrolled_return: f64,
+    pub scratch_final_return: f64,
+    pub threshold: f64,
+    pub episode_actions: usize,
+    pub runs: Vec<ArmRun>,
+    pub arms: Vec<ArmSummary>,
+    /// `100 (1 - episodes(finetune) / episodes(scratch))` to the threshold (the paper: ~50 %).
+    pub episode_saving_pct: f64,
+    /// `100 (1 - core-hours(finetune) / core-hours(scratch))` to the threshold.
+    pub cost_saving_pct: f64,
+}
+
+/// Why a comparison could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum CompareError {
+    #[error("cannot read {}", path.display())]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{}: {message}", path.display())]
+    Invalid { path: PathBuf, message: String },
+    #[error(transparent)]
+    Plot(#[from] crate::report::plots::PlotError),
+}
+
+fn read(path: &Path) -> Result<String, CompareError> {
+    std::fs::read_to_string(path).map_err(|source| CompareError::Read {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, CompareError> {
+    serde_json::from_str(&read(path)?).map_err(|e| CompareError::Invalid {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
+}
+
+/// Wall time and threads of a result folder's `manifest.json` (train or eval).
+fn cost(dir: &Path) -> Result<(f64, f64), CompareError> {
+    let m: serde_json::Value = json(&dir.join("manifest.json"))?;
+    let wall = m["manifest"]["wall_time_s"].as_f64().unwrap_or(f64::NAN);
+    let threads = m["manifest"]["threads"].as_f64().unwrap_or(f64::NAN);
+    Ok((wall, wall * threads / 3600.0))
+}
+
+/// Reads every arm of every seed under `root` and compares them; writes `transfer.png`.
+pub fn analyse(p: &Protocol, root: &Path, r0: f64, episode_actions: usize) -> Result<TransferComparison, CompareError> {
+    let mut curves: Vec<(String, Vec<CurveRow>)> = vec![];
+    let mut runs = vec![];
+    for arm in super::protocol::ARMS {
+        for &seed in &p.seeds {
+            let dir = p.arm_dir(root, arm, seed);
+            let report: EvalReport = json(&dir.join("metrics.json"))?;
+            let (wall_s, core_hours) = cost(&dir)?;
+            let rows = if arm == "zeroshot" {
+                vec![]
+            } else {
+                let path = dir.join("curve.csv");
+                from_csv(&read(&path)?).map_err(|e| CompareError::Invalid { path, message: e.0 })?
+            };
+            runs.push(ArmRun {
+                arm: arm.into(),
+                seed,
+                dir: dir.clone(),
+                final_drag_reduction_pct: report.drag_reduction_pct.mean,
+                final_return: report.ret.mean,
+                samples: rows.last().map_or(0, |r| r.samples),
+                samples_to_threshold: None,
+                wall_s,
+                core_hours,
+            });
+            curves.push((arm.into(), rows));
+        }
+    }
+    let scratch: Vec<f64> = curves.iter().filter(|c| c.0 == "scratch").map(|c| final_eval(&c.1)).collect();
+    let r_scratch = Stat::of(&scratch).mean;
+    let threshold = r0 + p.fraction * (r_scratch - r0);
+    for (run, (_, rows)) in runs.iter_mut().zip(&curves) {
+        run.samples_to_threshold = if run.arm == "zeroshot" {
+            (run.final_return >= threshold).then_some(0)
+        } else {
+            rows.iter()
+                .find(|r| r.eval_return.is_finite() && r.eval_return >= threshold)
+                .map(|r| r.samples)
+        };
+    }
+    let arms: Vec<ArmSummary> = super::protocol::ARMS
+        .iter()
+        .map(|arm| {
+            let mine: Vec<&ArmRun> = runs.iter().filter(|r| r.arm == *arm).collect();
+            let col = |f: fn(&ArmRun) -> f64| Stat::of(&mine.iter().map(|r| f(r)).collect::<Vec<_>>());
+            let reached: Vec<&&ArmRun> = mine.iter().filter(|r| r.samples_to_threshold.is_some()).collect();
+            let to = |r: &ArmRun| r.samples_to_threshold.unwrap_or(0) as f64;
+            ArmSummary {
+                arm: arm.to_string(),
+                final_drag_reduction_pct: col(|r| r.final_drag_reduction_pct),
+                final_return: col(|r| r.final_return),
+                samples_to_threshold: Stat::of(&reached.iter().map(|r| to(r)).collect::<Vec<_>>()),
+                episodes_to_threshold: Stat::of(&reached.iter().map(|r| to(r) / episode_actions as f64).collect::<Vec<_>>()),
+                seeds_reaching: reached.len(),
+                wall_s: col(|r| r.wall_s),
+                core_hours: mine.iter().map(|r| r.core_hours).sum(),
+                core_hours_to_threshold: Stat::of(
+                    &reached
+                        .iter()
+                        .map(|r| {
+                            if r.samples == 0 {
+                                r.core_hours
+                            } else {
+                                r.core_hours * to(r) / r.samples as f64
+                            }
+                        })
+                        .collect::<Vec<_>>(),
+                ),
+            }
+        })
+        .collect();
+    let get = |a: &str| arms.iter().find(|s| s.arm == a);
+    let saving = |f: fn(&ArmSummary) -> f64| match (get("finetune"), get("scratch")) {
+        (Some(ft), Some(sc)) => 100.0 * (1.0 - f(ft) / f(sc)),
+        _ => f64::NAN,
+    };
+    let cmp = TransferComparison {
+        schema: "hgym/transfer/v1".into(),
+        protocol: p.clone(),
+        uncontrolled_return: r0,
+        scratch_final_return: r_scratch,
+        threshold,
+        episode_actions,
+        episode_saving_pct: saving(|s| s.episodes_to_threshold.mean),
+        cost_saving_pct: saving(|s| s.core_hours_to_threshold.mean),
+        runs,
+        arms,
+    };
+    plot(p, &cmp, &curves, &root.join("transfer.png"))?;
+    Ok(cmp)
+}
+
+/// The fine-tuning and from-scratch learning curves (mean +- std), the zero-shot return, the
+/// threshold and the uncontrolled return; the episodes saved in the title.
+fn plot(p: &Protocol, cmp: &TransferComparison, curves: &[(String, Vec<CurveRow>)], path: &Path) -> Result<(), CompareError> {
+    let groups: Vec<(String, Vec<&[CurveRow]>)> = ["finetune", "scratch"]
+        .iter()
+        .map(|a| (a.to_string(), curves.iter().filter(|c| c.0 == *a).map(|c| &c.1[..]).collect()))
+        .collect();
+    let zs = cmp
+        .arms
+        .iter()
+        .find(|a| a.arm == "zeroshot")
+        .map_or(f64::NAN, |a| a.final_return.mean);
+    let hlines = [
+        ("zero-shot (source policy, mean)".to_string(), zs),
+        (format!("threshold ({:.0} % of scratch's gain)", 100.0 * p.fraction), cmp.threshold),
+        ("uncontrolled".to_string(), cmp.uncontrolled_return),
+    ];
+    let title = format!(
+        "{} -> {} ({}): fine-tuning saves {:.0} % of episodes",
+        p.source,
+        p.target,
+        p.level.name(),
+        cmp.episode_saving_pct
+    );
+    Ok(curve_plot(path, &title, &groups, &hlines)?)
+}

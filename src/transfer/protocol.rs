@@ -1,0 +1,200 @@
+//! Transfer protocols (`benchmarks/protocols/transfer/*.toml`, `hgym transfer SOURCE TARGET`):
+//! over the same seeds, a source policy (an ordinary run folder per seed) is evaluated zero-shot
+//! on the target, fine-tuned there from its policy, and compared with training from scratch on
+//! the target. Each arm of each seed is an ordinary run folder under
+//! `<out>/<name>/{zeroshot,finetune,scratch}/seed<S>/`, so a protocol resumes where it stopped.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::mapping::MappingSpec;
+use crate::flow::Level;
+use crate::train::config::TrainConfig;
+
+/// The protocols shipped with hgym (`hgym transfer --list`), by file name.
+pub const BUNDLED: &[(&str, &str)] = &[
+    (
+        "cylinder_re200_re1000",
+        include_str!("../../benchmarks/protocols/transfer/cylinder_re200_re1000.toml"),
+    ),
+    (
+        "cylinder_re1000_re3900",
+        include_str!("../../benchmarks/protocols/transfer/cylinder_re1000_re3900.toml"),
+    ),
+    (
+        "cylinder_square_re200",
+        include_str!("../../benchmarks/protocols/transfer/cylinder_square_re200.toml"),
+    ),
+];
+
+/// The three arms, in the order they run.
+pub const ARMS: [&str; 3] = ["zeroshot", "finetune", "scratch"];
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Protocol {
+    pub name: String,
+    pub description: String,
+    /// Source and target environment IDs.
+    pub source: String,
+    pub target: String,
+    /// Short names `hgym transfer` also accepts for the pair, e.g. ["channel", "naca0012"].
+    #[serde(default)]
+    pub alias: Vec<String>,
+    pub algo: String,
+    pub level: Level,
+    pub seeds: Vec<u64>,
+    /// The spec hash the source runs must have been trained on.
+    pub source_spec_hash: String,
+    /// The source run of each seed, `{seed}` standing for the seed: a `hgym train` folder
+    /// (`results/train/<source>-<algo>-<level>/seed{seed}`) or another protocol's arm.
+    pub source_runs: String,
+    /// Fraction of the from-scratch arm's final gain over the uncontrolled flow that defines
+    /// "reaching" it (samples and episodes to threshold).
+    pub fraction: f64,
+    #[serde(default)]
+    pub mapping: MappingSpec,
+    /// Training configuration of the source runs and of both training arms.
+    #[serde(default)]
+    pub config: TrainConfig,
+}
+
+/// A protocol file that cannot be used, or a pair without one (bad input).
+#[derive(Debug, thiserror::Error)]
+pub enum ProtocolError {
+    #[error("cannot read {}", path.display())]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{origin}: {message}")]
+    Invalid { origin: String, message: String },
+    #[error("no transfer protocol from '{source_name}' to '{target}'; the protocols are:\n{list}")]
+    UnknownPair { source_name: String, target: String, list: String },
+}
+
+impl Protocol {
+    /// Parses a protocol's text (`origin` names it in errors).
+    pub fn parse(text: &str, origin: &str) -> Result<Protocol, ProtocolError> {
+        let invalid = |message: String| ProtocolError::Invalid {
+            origin: origin.to_string(),
+            message,
+        };
+        let mut p: Protocol = toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
+        hgym_agents::learn::algorithm(&p.algo).map_err(|e| invalid(e.to_string()))?;
+        p.config.algos = p.config.algos.complete().map_err(|e| invalid(e.to_string()))?;
+        if p.seeds.is_empty() {
+            return Err(invalid("seeds must list at least one seed".into()));
+        }
+        if !(p.fraction > 0.0 && p.fraction <= 1.0) {
+            return Err(invalid(format!("fraction must be in (0, 1], got {}", p.fraction)));
+        }
+        if !p.alias.is_empty() && p.alias.len() != 2 {
+            return Err(invalid(format!(
+                "alias names the source and the target: two names, got {:?}",
+                p.alias
+            )));
+        }
+        Ok(p)
+    }
+
+    pub fn load(path: &Path) -> Result<Protocol, ProtocolError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ProtocolError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(&text, &path.display().to_string())
+    }
+
+    /// Every bundled protocol.
+    pub fn bundled() -> Vec<Protocol> {
+        BUNDLED
+            .iter()
+            .map(|(name, text)| Protocol::parse(text, name).expect("bundled protocols parse (tested)"))
+            .collect()
+    }
+
+    /// The bundled protocol for the pair, by environment ID or alias (any case).
+    pub fn find(source: &str, target: &str) -> Result<Protocol, ProtocolError> {
+        let is = |a: &str, b: &str| a.eq_ignore_ascii_case(b);
+        Self::bundled()
+            .into_iter()
+            .find(|p| {
+                (is(&p.source, source) || p.alias.first().is_some_and(|a| is(a, source)))
+                    && (is(&p.target, target) || p.alias.get(1).is_some_and(|a| is(a, target)))
+            })
+            .ok_or_else(|| ProtocolError::UnknownPair {
+                source_name: source.into(),
+                target: target.into(),
+                list: Self::listing(),
+            })
+    }
+
+    /// One line per bundled protocol: `SOURCE TARGET  description`.
+    pub fn listing() -> String {
+        Self::bundled()
+            .iter()
+            .map(|p| format!("  {} {}  ({})", p.source, p.target, p.description))
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+
+    /// The source run of `seed`.
+    pub fn source_dir(&self, seed: u64) -> PathBuf {
+        PathBuf::from(self.source_runs.replace("{seed}", &seed.to_string()))
+    }
+
+    /// The folder of `arm` for `seed` under the protocol's root.
+    pub fn arm_dir(&self, root: &Path, arm: &str, seed: u64) -> PathBuf {
+        root.join(arm).join(format!("seed{seed}"))
+    }
+
+    /// The command that makes the source runs: the bundled protocol whose from-scratch arm
+    /// they are, else `hgym train` with `config` (the file holding
+    /// [`Protocol::config`]) into the folders `source_runs` names.
+    pub fn source_command(&self, config: &Path) -> String {
+        let seed = self.seeds[0];
+        let dir = self.source_dir(seed);
+        let arm = |p: &Protocol| Path::new(&p.name).join("scratch").join(format!("seed{seed}"));
+        if let Some(p) = Self::bundled().iter().find(|p| dir.ends_with(arm(p))) {
+            let root = dir.parent().and_then(Path::parent).and_then(Path::parent).unwrap_or(Path::new("."));
+            return format!("hgym transfer {} {} --out {}", p.source, p.target, root.display());
+        }
+        let seeds: Vec<String> = self.seeds.iter().map(u64::to_string).collect();
+        let root = dir.parent().and_then(Path::parent).unwrap_or(Path::new("."));
+        format!(
+            "hgym train --env {} --algo {} --res {} --seeds {} --config {} --out {}",
+            self.source,
+            self.algo,
+            self.level.name(),
+            seeds.join(","),
+            config.display(),
+            root.display()
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bundled_protocols_parse_and_name_registered_environments() {
+        for p in Protocol::bundled() {
+            for id in [&p.source, &p.target] {
+                crate::env::lookup(id).unwrap_or_else(|e| panic!("{}: {e}", p.name));
+            }
+            assert!(p.seeds.len() >= 5, "{}: the 2D protocols run >= 5 seeds", p.name);
+            let spec = crate::train::resolve_spec(&p.source, &p.config).unwrap();
+            assert_eq!(spec.hash(), p.source_spec_hash, "{}: pinned source hash", p.name);
+        }
+        assert_eq!(
+            Protocol::find("cylinder_2d_re200", "Cylinder_2D_Re1000").unwrap().name,
+            "cylinder_re200_re1000"
+        );
+        let e = Protocol::find("channel", "naca0012").unwrap_err().to_string();
+        assert!(e.contains("Cylinder_2D_Re200 SquareCylinder_2D_Re200"), "{e}");
+    }
+}

@@ -1,0 +1,194 @@
+//! Transfer between flows on real environments (coarse, one round of small networks): a
+//! cylinder policy evaluated zero-shot on the square cylinder through the protocol's mapping,
+//! fine-tuned there with `--init-from` (its first evaluation is the zero-shot one, bitwise), a
+//! whole one-seed protocol through `hgym transfer`, and the bad input the issue names.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn hgym(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hgym")).args(args).output().expect("run hgym")
+}
+
+fn text(o: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+fn json(p: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))).unwrap()
+}
+
+/// Episodes of 50 actions, two rounds of two environments, small networks.
+const CONFIG: &str = "[train]\nsteps = 200\neval_every = 1\neval_episodes = 1\nfinal_eval_episodes = 1\n\
+                      [td3]\nhidden = [16, 16]\nbatch_size = 16\nlearning_starts = 100\n[env]\nepisode_actions = 50\n";
+
+const SQUARE: &str = "benchmarks/protocols/transfer/cylinder_square_re200.toml";
+
+#[test]
+fn zero_shot_fine_tuning_and_a_protocol_from_the_cylinder_to_the_square() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = tmp.path().join("small.toml");
+    std::fs::write(&cfg, CONFIG).unwrap();
+    let (cfg_s, out) = (cfg.to_str().unwrap(), tmp.path().to_str().unwrap());
+    let o = hgym(&["train", "--env", "Cylinder_2D_Re100", "--config", cfg_s, "--out", out]);
+    assert!(o.status.success(), "{}", text(&o));
+    let src = tmp.path().join("Cylinder_2D_Re100-td3-coarse/seed0");
+    let src_s = src.to_str().unwrap();
+
+    // Zero-shot: the jet pair has no namesake on the square; the protocol's mapping names it.
+    let o = hgym(&["eval", "--policy", src_s, "--env", "SquareCylinder_2D_Re200", "--episodes", "1"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("actuators jet_pair") && text(&o).contains("jet_rear_bottom"),
+        "{}",
+        text(&o)
+    );
+    let o = hgym(&[
+        "eval",
+        "--policy",
+        src_s,
+        "--env",
+        "SquareCylinder_2D_Re200",
+        "--episodes",
+        "1",
+        "--mapping",
+        SQUARE,
+        "--config",
+        cfg_s,
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let zero_shot: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+
+    // Fine-tuning starts from exactly that policy: its curve's row 0 is the zero-shot evaluation.
+    let ft = tmp.path().join("ft");
+    let o = hgym(&[
+        "train",
+        "--env",
+        "SquareCylinder_2D_Re200",
+        "--init-from",
+        src_s,
+        "--mapping",
+        SQUARE,
+        "--config",
+        cfg_s,
+        "--out",
+        ft.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let run = ft.join("SquareCylinder_2D_Re200-td3-coarse-from-Cylinder_2D_Re100-seed0/seed0");
+    let curve = std::fs::read_to_string(run.join("curve.csv")).unwrap();
+    let row0: Vec<&str> = curve.lines().nth(1).unwrap().split(',').collect();
+    assert_eq!(&row0[..3], ["0", "0", "0"], "{curve}");
+    assert_eq!(
+        row0[6].parse::<f64>().unwrap(),
+        zero_shot["ret"]["mean"].as_f64().unwrap(),
+        "{curve}"
+    );
+    let m = json(&run.join("manifest.json"));
+    assert_eq!(m["init_from"]["env_id"], "Cylinder_2D_Re100");
+    assert_eq!(m["init_from"]["mapping"]["actions"]["jet_front_bottom"], "-jet_pair");
+    assert_eq!(m["init_from"]["identity"], false);
+    // Critics need the source's checkpoint and a learner with critics; PPO has none to take.
+    let o = hgym(&[
+        "train",
+        "--env",
+        "SquareCylinder_2D_Re200",
+        "--init-from",
+        src_s,
+        "--mapping",
+        SQUARE,
+        "--algo",
+        "ppo",
+        "--steps",
+        "1",
+        "--out",
+        out,
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("use --algo td3"), "{}", text(&o));
+
+    // A one-seed protocol with this source: three arms, the comparison and its plot.
+    let protocol = std::fs::read_to_string(SQUARE)
+        .unwrap()
+        .replace("seeds = [0, 1, 2, 3, 4]", "seeds = [0]")
+        .replace("source = \"Cylinder_2D_Re200\"", "source = \"Cylinder_2D_Re100\"")
+        .replace(
+            "results/train/Cylinder_2D_Re200-td3-coarse/seed{seed}",
+            &format!("{out}/Cylinder_2D_Re100-td3-coarse/seed{{seed}}"),
+        )
+        .replace(
+            "[config.train]\nsteps = 20000\n",
+            CONFIG
+                .replace("[train]", "[config.train]")
+                .replace("[td3]", "[config.td3]")
+                .replace("[env]", "[config.env]")
+                .as_str(),
+        );
+    let pfile = tmp.path().join("protocol.toml");
+    let hash_line = protocol.lines().find(|l| l.starts_with("source_spec_hash")).unwrap().to_string();
+    std::fs::write(&pfile, &protocol).unwrap();
+    let tout = tmp.path().join("transfer");
+    let args = [
+        "transfer",
+        "--protocol",
+        pfile.to_str().unwrap(),
+        "--out",
+        tout.to_str().unwrap(),
+        "--json",
+    ];
+    // The pinned hash is the Re 200 cylinder's: this source is refused, with the command to make one.
+    let o = hgym(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("hgym train --env Cylinder_2D_Re100"), "{}", text(&o));
+    let hash = json(&src.join("manifest.json"))["spec_hash"].as_str().unwrap().to_string();
+    std::fs::write(&pfile, protocol.replace(&hash_line, &format!("source_spec_hash = \"{hash}\""))).unwrap();
+    let o = hgym(&args);
+    assert!(o.status.success(), "{}", text(&o));
+    let root = tout.join("cylinder_square_re200");
+    let cmp = json(&root.join("comparison.json"));
+    assert_eq!(cmp["schema"], "hgym/transfer/v1");
+    assert!(root.join("transfer.png").exists());
+    let arms: Vec<&str> = cmp["arms"].as_array().unwrap().iter().map(|a| a["arm"].as_str().unwrap()).collect();
+    assert_eq!(arms, ["zeroshot", "finetune", "scratch"]);
+    // The protocol's zero-shot arm and `hgym eval` agree (same policy, seeds, mapping).
+    let zs = json(&root.join("zeroshot/seed0/metrics.json"));
+    assert_eq!(zs["ret"]["mean"], zero_shot["ret"]["mean"]);
+    // The threshold is 90 % of the from-scratch arm's gain over the uncontrolled flow.
+    let (r0, rs, th) = (
+        cmp["uncontrolled_return"].as_f64().unwrap(),
+        cmp["scratch_final_return"].as_f64().unwrap(),
+        cmp["threshold"].as_f64().unwrap(),
+    );
+    assert!((th - (r0 + 0.9 * (rs - r0))).abs() < 1e-9 * r0.abs(), "{cmp}");
+    // A second call finds every arm done and only recomputes the comparison.
+    let o = hgym(&args[..args.len() - 1]);
+    assert!(o.status.success() && text(&o).matches("done already").count() == 3, "{}", text(&o));
+}
+
+#[test]
+fn unknown_pairs_and_missing_sources_exit_2_saying_what_to_run() {
+    let o = hgym(&["transfer", "channel", "naca0012"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).contains("Cylinder_2D_Re200 Cylinder_2D_Re1000"), "{}", text(&o));
+    let tmp = tempfile::tempdir().unwrap();
+    let o = hgym(&["transfer", "re1000", "re3900", "--out", tmp.path().to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    // Its sources are another protocol's from-scratch arm: that protocol is the command.
+    assert!(
+        text(&o).contains("hgym transfer Cylinder_2D_Re200 Cylinder_2D_Re1000"),
+        "{}",
+        text(&o)
+    );
+    let o = hgym(&[
+        "train",
+        "--env",
+        "Cylinder_2D_Re100",
+        "--init-from",
+        tmp.path().to_str().unwrap(),
+        "--steps",
+        "1",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).contains("holds no finished training run"), "{}", text(&o));
+}
