@@ -172,7 +172,13 @@ fn unknown_pairs_and_missing_sources_exit_2_saying_what_to_run() {
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o).contains("Cylinder_2D_Re200 Cylinder_2D_Re1000"), "{}", text(&o));
     let tmp = tempfile::tempdir().unwrap();
-    let o = hgym(&["transfer", "re1000", "re3900", "--out", tmp.path().to_str().unwrap()]);
+    // From an empty folder: the protocol's relative source paths name nothing there (in the
+    // repository they name the committed Re 1000 runs, and the protocol would start training).
+    let o = Command::new(env!("CARGO_BIN_EXE_hgym"))
+        .args(["transfer", "re1000", "re3900", "--out", "."])
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(2));
     // Its sources are another protocol's from-scratch arm: that protocol is the command.
     assert!(
