@@ -5,13 +5,15 @@
 //! lattice needs (which nodes are solid, where a lattice link crosses the wall, the wall normal)
 //! follows from `phi`, so a new shape only has to say how far a point is from it. Circles,
 //! rectangles (square cylinders), NACA 4-digit aerofoils, half-planes (channel walls), open
-//! cavities and channel stenoses are here.
+//! cavities and channel stenoses are here; in 3D ([`Solid`]) spheres, cuboids and any of those
+//! sections extruded along the span.
 
 mod cavity;
 mod circle;
 mod naca;
 mod plane;
 mod rectangle;
+mod solid;
 mod stenosis;
 
 pub use cavity::OpenCavity;
@@ -19,6 +21,7 @@ pub use circle::Circle;
 pub use naca::Naca4;
 pub use plane::HalfPlane;
 pub use rectangle::Rectangle;
+pub use solid::{Cuboid, Extruded, Solid, Sphere};
 pub use stenosis::Stenosis;
 
 /// A closed body described by a signed distance function (negative inside).

@@ -12,6 +12,10 @@ pub enum LbmError {
     #[error("the solver diverged at step {step}: {reason} at node ({x}, {y})")]
     Diverged { step: u64, reason: String, x: usize, y: usize },
 
+    /// The 3D solution left the physically meaningful range.
+    #[error("the solver diverged at step {step}: {reason} at node ({}, {}, {})", at[0], at[1], at[2])]
+    Diverged3 { step: u64, reason: String, at: [usize; 3] },
+
     /// A probe point outside the grid.
     #[error("probe point ({x:.4}, {y:.4}) lies outside the domain [{xmin:.4}, {xmax:.4}] x [{ymin:.4}, {ymax:.4}]")]
     ProbeOutside {

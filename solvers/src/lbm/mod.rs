@@ -1,4 +1,4 @@
-//! Lattice Boltzmann method, D2Q9.
+//! Lattice Boltzmann method, D2Q9 (this module) and D3Q19/D3Q27 ([`d3`]).
 //!
 //! The source is modular (lattice, collision, one file per boundary) and fused at run time: one
 //! pull-scheme stream-collide pass per step that, for every node, loads the nine populations from
@@ -14,6 +14,7 @@ mod aligned;
 pub mod boundary;
 mod check;
 pub mod collision;
+pub mod d3;
 mod domain;
 mod error;
 mod forces;

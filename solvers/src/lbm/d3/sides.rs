@@ -1,0 +1,129 @@
+//! The six faces of the 3D box and what enters through them. Faces sit half-way between the
+//! last node and the (absent) next one, as in 2D; the rules are those of the 2D
+//! [`Side`](crate::lbm::Side), written for any direction of a 3D lattice.
+
+use super::collision::moments;
+use super::kernel::Ctx;
+use super::lattice::Lattice3;
+
+/// What happens at one face of the box.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Face {
+    /// Wraps to the opposite face (both faces of an axis must be periodic).
+    Periodic,
+    /// Resting no-slip wall, half-way bounce-back.
+    Wall,
+    /// Free-slip (specular reflection): zero normal velocity, zero shear.
+    FreeSlip,
+    /// Uniform velocity (lattice units) by half-way bounce-back with the moving-wall term
+    /// `g_k = g*_{opp k} + 6 w_k rho c_k.u`: an inlet, scaled by the solver's velocity scale
+    /// (ramps, gusts).
+    Velocity([f32; 3]),
+    /// Open boundary: zero gradient across the face, shifted to the equilibrium at `rho = 1`
+    /// (non-equilibrium extrapolation, Guo, Zheng & Shi 2002), which anchors the pressure.
+    Outlet,
+}
+
+impl Face {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Face::Periodic => "periodic",
+            Face::Wall => "wall",
+            Face::FreeSlip => "free-slip",
+            Face::Velocity(_) => "velocity",
+            Face::Outlet => "outlet",
+        }
+    }
+
+    fn is_wall_like(&self) -> bool {
+        matches!(self, Face::Wall | Face::FreeSlip | Face::Velocity(_))
+    }
+}
+
+/// The faces of the box: `faces[2 a]` at the low end of axis `a` (x = -1/2), `faces[2 a + 1]`
+/// at the high end.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Faces(pub [Face; 6]);
+
+impl Faces {
+    /// Periodic along every axis.
+    pub fn periodic() -> Self {
+        Faces(std::array::from_fn(|_| Face::Periodic))
+    }
+
+    /// Whether axis `a` wraps.
+    pub fn periodic_axis(&self, a: usize) -> bool {
+        self.0[2 * a] == Face::Periodic
+    }
+
+    /// The first axis whose two faces disagree on being periodic.
+    pub(crate) fn mismatched_axis(&self) -> Option<usize> {
+        (0..3).find(|&a| (self.0[2 * a] == Face::Periodic) != (self.0[2 * a + 1] == Face::Periodic))
+    }
+}
+
+/// Value entering fluid node `p` in direction `k` whose source `p - c_k` lies outside the box.
+#[inline]
+pub(crate) fn face_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p: [usize; 3], k: usize) -> f32 {
+    let ck = L::C[k];
+    let s = [0, 1, 2].map(|a| p[a] as isize - ck[a] as isize);
+    // The faces crossed; at an edge or corner a wall wins over an outlet, then the last axis.
+    let mut face: Option<usize> = None;
+    for a in 0..3 {
+        if c.periodic[a] || (0..c.n[a] as isize).contains(&s[a]) {
+            continue;
+        }
+        let f = 2 * a + usize::from(s[a] >= 0);
+        let better = match face {
+            None => true,
+            Some(g) => c.faces.0[f].is_wall_like() || !c.faces.0[g].is_wall_like(),
+        };
+        if better {
+            face = Some(f);
+        }
+    }
+    let opp = L::OPP[k];
+    let Some(f) = face else {
+        // Not outside: cannot happen (a solid source inside the box always has a link).
+        return src[c.idx::<Q>(p, opp)];
+    };
+    match &c.faces.0[f] {
+        Face::Periodic | Face::Wall => src[c.idx::<Q>(p, opp)],
+        Face::Velocity(u) => {
+            let g: [f32; Q] = std::array::from_fn(|i| src[c.idx::<Q>(p, i)]);
+            let rho = 1.0 + moments::<Q, L>(&g).0;
+            let cu = ck[0] as f32 * u[0] + ck[1] as f32 * u[1] + ck[2] as f32 * u[2];
+            src[c.idx::<Q>(p, opp)] + 6.0 * L::W[k] * rho * cu * c.velocity_scale
+        }
+        Face::FreeSlip => {
+            // Specular reflection: the population arriving with c_k left the neighbour along the
+            // wall with its normal component reversed.
+            let a = f / 2;
+            let mut m = ck;
+            m[a] = -m[a];
+            let mirrored = (0..Q).find(|&i| L::C[i] == m).unwrap_or(opp);
+            let mut d = ck.map(|v| -v);
+            d[a] = 0;
+            let b = c.neighbour(p, d).filter(|&b| !c.is_solid(b)).unwrap_or(p);
+            src[c.idx::<Q>(b, mirrored)]
+        }
+        Face::Outlet => {
+            // Zero gradient: the populations of the node across the face, clamped into the box.
+            let b = [0, 1, 2].map(|a| {
+                if c.periodic[a] {
+                    s[a].rem_euclid(c.n[a] as isize) as usize
+                } else {
+                    s[a].clamp(0, c.n[a] as isize - 1) as usize
+                }
+            });
+            let b = if c.is_solid(b) { p } else { b };
+            let g: [f32; Q] = std::array::from_fn(|i| src[c.idx::<Q>(b, i)]);
+            let (drho, j) = moments::<Q, L>(&g);
+            let rho = 1.0 + drho;
+            let u = j.map(|v| v / rho);
+            let cu = 3.0 * (ck[0] as f32 * u[0] + ck[1] as f32 * u[1] + ck[2] as f32 * u[2]);
+            let shape = 1.0 + cu + 0.5 * cu * cu - 1.5 * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+            g[k] - drho * L::W[k] * shape
+        }
+    }
+}
