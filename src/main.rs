@@ -159,8 +159,6 @@ fn is_bad_input(e: &anyhow::Error) -> bool {
             || c.downcast_ref::<hgym::train::checkpoint::CheckpointError>()
                 .is_some_and(|t| t.is_bad_input())
             || c.downcast_ref::<hgym::transfer::TransferError>().is_some_and(|t| t.is_bad_input())
-            || c.downcast_ref::<hgym::transfer::compare::CompareError>()
-                .is_some_and(|t| matches!(t, hgym::transfer::compare::CompareError::Invalid { .. }))
             || c.downcast_ref::<hgym::train::compare::CompareError>()
                 .is_some_and(|t| t.is_bad_input())
             || matches!(c.downcast_ref::<hgym::data::DataError>(), Some(hgym::data::DataError::Format(_)))

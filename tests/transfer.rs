@@ -62,7 +62,7 @@ fn zero_shot_fine_tuning_and_a_protocol_from_the_cylinder_to_the_square() {
 
     // Fine-tuning starts from exactly that policy: its curve's row 0 is the zero-shot evaluation.
     let ft = tmp.path().join("ft");
-    let o = hgym(&[
+    let fine_tune = [
         "train",
         "--env",
         "SquareCylinder_2D_Re200",
@@ -70,11 +70,8 @@ fn zero_shot_fine_tuning_and_a_protocol_from_the_cylinder_to_the_square() {
         src_s,
         "--mapping",
         SQUARE,
-        "--config",
-        cfg_s,
-        "--out",
-        ft.to_str().unwrap(),
-    ]);
+    ];
+    let o = hgym(&[&fine_tune[..], &["--config", cfg_s, "--out", ft.to_str().unwrap()]].concat());
     assert!(o.status.success(), "{}", text(&o));
     let run = ft.join("SquareCylinder_2D_Re200-td3-coarse-from-Cylinder_2D_Re100-seed0/seed0");
     let curve = std::fs::read_to_string(run.join("curve.csv")).unwrap();
@@ -90,21 +87,7 @@ fn zero_shot_fine_tuning_and_a_protocol_from_the_cylinder_to_the_square() {
     assert_eq!(m["init_from"]["mapping"]["actions"]["jet_front_bottom"], "-jet_pair");
     assert_eq!(m["init_from"]["identity"], false);
     // Critics need the source's checkpoint and a learner with critics; PPO has none to take.
-    let o = hgym(&[
-        "train",
-        "--env",
-        "SquareCylinder_2D_Re200",
-        "--init-from",
-        src_s,
-        "--mapping",
-        SQUARE,
-        "--algo",
-        "ppo",
-        "--steps",
-        "1",
-        "--out",
-        out,
-    ]);
+    let o = hgym(&[&fine_tune[..], &["--algo", "ppo", "--steps", "1", "--out", out]].concat());
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));
     assert!(text(&o).contains("use --algo td3"), "{}", text(&o));
 

@@ -599,6 +599,42 @@ pub struct CompareArgs {
     threads: Option<usize>,
 }
 
+/// One run of a protocol (`hgym compare`, `hgym transfer`) in `opts.out`, with a progress bar:
+/// resumed from its checkpoint when one is there (then without `opts.init`: the checkpoint holds
+/// the networks), else started. Ctrl-C keeps the checkpoint and exits 130; the same command
+/// continues.
+pub fn protocol_run(pool: &rayon::ThreadPool, mut opts: TrainOptions, label: &str) -> Result<()> {
+    let resume = if opts.out.join(hgym::train::checkpoint::FILE).exists() {
+        opts.init = None;
+        Some(hgym::train::checkpoint::load(&opts.out)?)
+    } else {
+        None
+    };
+    let pb = progress_bar(opts.config.train.steps, label);
+    let ending = pool
+        .install(|| {
+            hgym::train::train(
+                &opts,
+                resume,
+                &mut |pr| {
+                    pb.set_position(pr.samples.min(pr.total));
+                    if pb.is_hidden() && pr.round % 20 == 0 {
+                        eprintln!("{label}: {} / {} samples, return {:.2}", pr.samples, pr.total, pr.train_return);
+                    }
+                },
+                &|| INTERRUPTED.load(Ordering::SeqCst),
+            )
+        })
+        .map_err(train_error)
+        .with_context(|| format!("{label} on {}", opts.env_id))?;
+    pb.finish_and_clear();
+    if let Ending::Interrupted { .. } = ending {
+        eprintln!("stopped; run the same command again to continue where it stopped");
+        std::process::exit(130);
+    }
+    Ok(())
+}
+
 /// `hgym compare`: every (algorithm, seed) of a protocol, then samples-to-threshold.
 pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
     use hgym::train::compare::{analyse, uncontrolled_return, Protocol};
@@ -622,14 +658,9 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
             for seed in &p.seeds {
                 let dir = root.join(algo).join(format!("seed{seed}"));
                 if dir.join("metrics.json").exists() {
-                    eprintln!("{} seed {seed}: done already ({})", algo, dir.display());
+                    eprintln!("{algo} s{seed}: done already ({})", dir.display());
                     continue;
                 }
-                let resume = if dir.join(hgym::train::checkpoint::FILE).exists() {
-                    Some(hgym::train::checkpoint::load(&dir)?)
-                } else {
-                    None
-                };
                 let opts = TrainOptions {
                     env_id: p.env.clone(),
                     algo: algo.clone(),
@@ -640,29 +671,8 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
                     cache: hgym::env::default_cache_dir(),
                     init: None,
                 };
-                let label = format!("{algo} s{seed}");
-                let pb = progress_bar(p.config.train.steps, &label);
-                let ending = pool
-                    .install(|| {
-                        hgym::train::train(
-                            &opts,
-                            resume,
-                            &mut |pr| {
-                                pb.set_position(pr.samples.min(pr.total));
-                                if pb.is_hidden() && pr.round % 20 == 0 {
-                                    eprintln!("{label}: {} / {} samples, return {:.2}", pr.samples, pr.total, pr.train_return);
-                                }
-                            },
-                            &|| INTERRUPTED.load(Ordering::SeqCst),
-                        )
-                    })
-                    .map_err(train_error)?;
-                pb.finish_and_clear();
-                if let Ending::Interrupted { .. } = ending {
-                    eprintln!("stopped; run the same command again to continue where it stopped");
-                    std::process::exit(130);
-                }
-                eprintln!("{} seed {seed}: finished ({})", algo, dir.display());
+                protocol_run(&pool, opts, &format!("{algo} s{seed}"))?;
+                eprintln!("{algo} s{seed}: finished ({})", dir.display());
             }
         }
     }

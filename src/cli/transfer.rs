@@ -1,18 +1,16 @@
 //! `hgym transfer`: a transfer protocol's three arms over its seeds, then their comparison.
 
 use std::path::PathBuf;
-use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::Args;
 use hgym::train::eval::{evaluate, uncontrolled_c_d};
-use hgym::train::{checkpoint, resolve_spec, Ending, TrainOptions};
+use hgym::train::{resolve_spec, TrainOptions};
 use hgym::transfer::protocol::{Protocol, ARMS};
 use hgym::transfer::SourceRun;
 
-use crate::cli::progress::progress_bar;
-use crate::cli::train::{init_from, install_interrupt, INTERRUPTED};
+use crate::cli::train::{init_from, install_interrupt, protocol_run};
 use crate::{thread_pool, Outcome, UsageError};
 
 #[derive(Args)]
@@ -73,6 +71,15 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
             )));
         }
         let src = SourceRun::load(&dir).map_err(usage)?;
+        if p.init_critics && !dir.join(hgym::train::checkpoint::FILE).exists() {
+            return Err(usage(format!(
+                "{}: the fine-tuning arm starts from the source's critics, and {} has no checkpoint (run folders commit \
+                 their policy, not their 50 MB checkpoint); make the source runs here with:\n  {}",
+                p.name,
+                dir.display(),
+                p.source_command(&config_file)
+            )));
+        }
         if src.spec_hash != p.source_spec_hash || src.env_id != p.source || src.algo != p.algo {
             return Err(usage(format!(
                 "{}: {} is {} {} on spec {}, the protocol's source is {} {} on spec {}; retrain it with:\n  {}",
@@ -108,13 +115,8 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
                     eprintln!("{label}: evaluated ({})", dir.display());
                     continue;
                 }
-                let resume = if dir.join(checkpoint::FILE).exists() {
-                    Some(checkpoint::load(&dir)?)
-                } else {
-                    None
-                };
-                let init = match (arm, &resume) {
-                    ("finetune", None) => Some(init_from(src, &target, &p.mapping, false, false)?),
+                let init = match arm {
+                    "finetune" => Some(init_from(src, &target, &p.mapping, p.init_critics, false)?),
                     _ => None,
                 };
                 let opts = TrainOptions {
@@ -127,27 +129,7 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
                     cache: hgym::env::default_cache_dir(),
                     init,
                 };
-                let pb = progress_bar(p.config.train.steps, &label);
-                let ending = pool
-                    .install(|| {
-                        hgym::train::train(
-                            &opts,
-                            resume,
-                            &mut |pr| {
-                                pb.set_position(pr.samples.min(pr.total));
-                                if pb.is_hidden() && pr.round % 20 == 0 {
-                                    eprintln!("{label}: {} / {} samples, return {:.2}", pr.samples, pr.total, pr.train_return);
-                                }
-                            },
-                            &|| INTERRUPTED.load(Ordering::SeqCst),
-                        )
-                    })
-                    .with_context(|| format!("{label} on {}", p.target))?;
-                pb.finish_and_clear();
-                if let Ending::Interrupted { .. } = ending {
-                    eprintln!("stopped; run the same command again to continue where it stopped");
-                    std::process::exit(130);
-                }
+                protocol_run(&pool, opts, &label)?;
                 eprintln!("{label}: finished ({})", dir.display());
             }
         }

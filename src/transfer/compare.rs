@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::protocol::Protocol;
-use crate::train::compare::{curve_plot, final_eval};
+use crate::train::compare::{curve_plot, final_eval, CompareError};
 use crate::train::curve::{from_csv, CurveRow};
 use crate::train::eval::{EvalReport, Stat};
 
@@ -62,21 +62,6 @@ pub struct TransferComparison {
     pub episode_saving_pct: f64,
     /// `100 (1 - core-hours(finetune) / core-hours(scratch))` to the threshold.
     pub cost_saving_pct: f64,
-}
-
-/// Why a comparison could not be made.
-#[derive(Debug, thiserror::Error)]
-pub enum CompareError {
-    #[error("cannot read {}", path.display())]
-    Read {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
-    #[error("{}: {message}", path.display())]
-    Invalid { path: PathBuf, message: String },
-    #[error(transparent)]
-    Plot(#[from] crate::report::plots::PlotError),
 }
 
 fn read(path: &Path) -> Result<String, CompareError> {

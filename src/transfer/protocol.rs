@@ -55,6 +55,11 @@ pub struct Protocol {
     pub fraction: f64,
     #[serde(default)]
     pub mapping: MappingSpec,
+    /// The fine-tuning arm also starts from the source's critics (and their targets, through
+    /// the mapping; off-policy learners), read from each source run's checkpoint. Without them a
+    /// TD3 actor is trained against a fresh critic and loses what it knew in its first updates.
+    #[serde(default)]
+    pub init_critics: bool,
     /// Training configuration of the source runs and of both training arms.
     #[serde(default)]
     pub config: TrainConfig,
