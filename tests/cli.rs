@@ -782,3 +782,42 @@ fn a_refined_case_runs_records_its_patch_and_improves_the_drag() {
     let err = refused(dir.path(), "st_bad", &bad);
     assert!(err.contains("refinement.regions") && err.contains("inside the domain"), "{err}");
 }
+
+/// A 3D case (a `[span]`) runs through the same command: the sphere case on a small box at 4
+/// cells per D for a few D/U. Its drag is far from converged (the test checks the path, not the
+/// number: exit 0 or 1, a schema-valid report with the third axis, a finite positive drag and
+/// the mid-span vorticity plot); a span that is not a whole number of cells is refused first.
+#[test]
+fn a_3d_case_runs_through_the_span_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let template = std::fs::read_to_string(repo().join("benchmarks/validation/sphere_re100.toml")).unwrap();
+    let mut body = template.clone();
+    for (from, to) in [
+        ("center = [6.0, 6.0, 6.0]", "center = [3.0, 3.0, 3.0]"),
+        ("x = [0.0, 20.0]", "x = [0.0, 10.0]"),
+        ("y = [0.0, 12.0]", "y = [0.0, 6.0]"),
+        ("z = [0.0, 12.0]", "z = [0.0, 6.0]"),
+        ("coarse = 8", "coarse = 4"),
+        ("spin_up = 30.0", "spin_up = 2.0"),
+        ("average = 10.0", "average = 2.0"),
+    ] {
+        assert!(body.contains(from), "template has no '{from}'");
+        body = body.replace(from, to);
+    }
+    let case = write_case(dir.path(), "sphere_small", &body);
+    let out = dir.path().join("out");
+    let o = run_coarse(&case, &out, false);
+    let (stdout, stderr) = text(&o);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "stdout: {stdout}\nstderr: {stderr}");
+    assert!(stderr.contains("40 x 24 x 24 nodes"), "the grid and its memory come first: {stderr}");
+    assert!(stdout.contains("40 x 24 x 24 cells"), "{stdout}");
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("sphere_re100.json")).unwrap()).unwrap();
+    schema_check(&report);
+    assert_eq!(report["parameters"]["nz"], 24);
+    let cd = measured(&report, "mean_cd");
+    assert!(cd.is_finite() && cd > 0.5 && cd < 5.0, "C_D {cd}");
+    assert!(out.join("sphere_re100/vorticity.png").exists());
+
+    let err = refused(dir.path(), "ragged_span", &body.replace("z = [0.0, 6.0]", "z = [0.0, 6.1]"));
+    assert!(err.contains("span.z") && err.contains("whole number of cells"), "{err}");
+}

@@ -1,7 +1,8 @@
-//! The D2Q9 kernel benchmark.
+//! The lattice-Boltzmann kernel benchmark (D2Q9, D3Q19, D3Q27).
 
 use std::time::Instant;
 
+use hgym_solvers::lbm::d3::{D3Config, D3q19, D3q27, Lattice3, Lbm3};
 use hgym_solvers::lbm::lattice::BYTES_PER_CELL_F32;
 use hgym_solvers::lbm::{Collision, D2q9, D2q9Config, Sides};
 use serde::{Deserialize, Serialize};
@@ -10,10 +11,51 @@ use super::BenchError;
 
 use super::stream::stream_copy_gbs;
 
+/// The velocity set a benchmark times.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BenchLattice {
+    D2q9,
+    D3q19,
+    D3q27,
+}
+
+impl BenchLattice {
+    pub fn name(self) -> &'static str {
+        match self {
+            BenchLattice::D2q9 => "d2q9",
+            BenchLattice::D3q19 => "d3q19",
+            BenchLattice::D3q27 => "d3q27",
+        }
+    }
+
+    /// Bytes per cell update of the FP32 A-B kernel: `2 Q 4`.
+    pub fn bytes_per_cell(self) -> usize {
+        match self {
+            BenchLattice::D2q9 => BYTES_PER_CELL_F32,
+            BenchLattice::D3q19 => D3q19::BYTES_PER_CELL_F32,
+            BenchLattice::D3q27 => D3q27::BYTES_PER_CELL_F32,
+        }
+    }
+
+    /// A cache-resident, a last-level-cache and a memory-bound size (the last one, well above
+    /// this machine's 300 MB L3).
+    pub fn default_sizes(self) -> Vec<[usize; 3]> {
+        match self {
+            // 0.3 MB, 9.4 MB, 302 MB at 72 B per node.
+            BenchLattice::D2q9 => vec![[64, 64, 1], [512, 256, 1], [2048, 2048, 1]],
+            // D3Q19: 2.1 MB, 40 MB, 623 MB (D3Q27: 3.0, 57, 885 MB).
+            _ => vec![[24, 24, 24], [64, 64, 64], [160, 160, 160]],
+        }
+    }
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct BenchRow {
     pub nx: usize,
     pub ny: usize,
+    #[serde(default = "one")]
+    pub nz: usize,
     /// Size of the two population arrays in MB.
     pub megabytes: f64,
     pub threads: usize,
@@ -31,9 +73,15 @@ pub struct BenchRow {
     pub memory_bound: bool,
 }
 
+fn one() -> usize {
+    1
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct BenchReport {
     pub schema: String,
+    #[serde(default = "d2q9")]
+    pub lattice: BenchLattice,
     pub bytes_per_cell: usize,
     pub rows: Vec<BenchRow>,
     /// Fraction of the roofline required at the memory-bound size.
@@ -42,10 +90,15 @@ pub struct BenchReport {
     pub manifest: crate::report::manifest::Manifest,
 }
 
+fn d2q9() -> BenchLattice {
+    BenchLattice::D2q9
+}
+
 #[derive(Clone, Debug)]
 pub struct LbmBenchOptions {
-    /// Grid sizes; the last is the memory-bound one.
-    pub sizes: Vec<(usize, usize)>,
+    pub lattice: BenchLattice,
+    /// Grid sizes (nx, ny, nz; nz = 1 in 2D); the last is the memory-bound one.
+    pub sizes: Vec<[usize; 3]>,
     pub threads: Vec<usize>,
     /// Seconds of timed stepping per row (at least three steps).
     pub seconds: f64,
@@ -56,8 +109,8 @@ pub struct LbmBenchOptions {
 impl Default for LbmBenchOptions {
     fn default() -> Self {
         LbmBenchOptions {
-            // 0.3 MB (L2), 9.4 MB (L3), 302 MB (DRAM): the A-B arrays are 72 B per node.
-            sizes: vec![(64, 64), (512, 256), (2048, 2048)],
+            lattice: BenchLattice::D2q9,
+            sizes: BenchLattice::D2q9.default_sizes(),
             threads: vec![1, 2],
             seconds: 1.5,
             stream_values: 1 << 26,
@@ -66,25 +119,88 @@ impl Default for LbmBenchOptions {
     }
 }
 
-/// Taylor-Green vortex on an `nx x ny` periodic grid; returns the solver and the exact velocity
-/// amplitude decay rate.
-fn taylor_green(nx: usize, ny: usize, collision: Collision) -> Result<(D2q9, f64, f64, f64), BenchError> {
-    let tau = 0.6;
-    let mut cfg = D2q9Config::new(nx, ny, tau, Sides::periodic());
+/// Amplitude of the Taylor-Green vortex every benchmark runs.
+const U0: f64 = 0.02;
+const TAU: f64 = 0.6;
+
+/// A solver stepping a Taylor-Green vortex `u = -u0 cos(kx x) sin(ky y)`,
+/// `v = u0 kx/ky sin(kx x) cos(ky y)` (uniform along z in 3D), which decays as
+/// `exp(-nu (kx^2 + ky^2) t)` exactly.
+trait Vortex {
+    fn advance(&mut self, steps: u64) -> Result<(), BenchError>;
+    fn time(&self) -> u64;
+    /// x velocity at node (x, y) (z = 0).
+    fn u(&self, x: usize, y: usize) -> f64;
+}
+
+impl Vortex for D2q9 {
+    fn advance(&mut self, steps: u64) -> Result<(), BenchError> {
+        Ok(D2q9::advance(self, steps)?)
+    }
+    fn time(&self) -> u64 {
+        D2q9::time(self)
+    }
+    fn u(&self, x: usize, y: usize) -> f64 {
+        self.node(x, y).1 as f64
+    }
+}
+
+impl<const Q: usize, L: Lattice3<Q>> Vortex for Lbm3<Q, L> {
+    fn advance(&mut self, steps: u64) -> Result<(), BenchError> {
+        for _ in 0..steps {
+            self.step()?;
+        }
+        Ok(())
+    }
+    fn time(&self) -> u64 {
+        Lbm3::time(self)
+    }
+    fn u(&self, x: usize, y: usize) -> f64 {
+        self.rho_u([x, y, 0]).1[0]
+    }
+}
+
+fn vortex_3d<const Q: usize, L: Lattice3<Q>>(n: [usize; 3], collision: Collision, k: [f64; 2]) -> Result<Box<dyn Vortex>, BenchError> {
+    let mut cfg = D3Config::new(n, TAU);
     cfg.collision = collision;
     cfg.check_interval = 0;
-    let mut s = D2q9::new(cfg, vec![])?;
-    let (kx, ky) = (2.0 * std::f64::consts::PI / nx as f64, 2.0 * std::f64::consts::PI / ny as f64);
-    let u0 = 0.02;
-    s.init_with(|x, y| {
+    let mut s = Lbm3::<Q, L>::new(cfg, &[])?;
+    s.set_equilibrium(|x, y, _| {
+        let (x, y) = (x as f64, y as f64);
         (
             1.0,
-            -u0 * (kx * x).cos() * (ky * y).sin(),
-            u0 * kx / ky * (kx * x).sin() * (ky * y).cos(),
+            [
+                -U0 * (k[0] * x).cos() * (k[1] * y).sin(),
+                U0 * k[0] / k[1] * (k[0] * x).sin() * (k[1] * y).cos(),
+                0.0,
+            ],
         )
     });
-    let nu = (tau - 0.5) / 3.0;
-    Ok((s, nu * (kx * kx + ky * ky), kx, ky))
+    Ok(Box::new(s))
+}
+
+/// The Taylor-Green vortex on a periodic grid of `n` nodes.
+fn taylor_green(lattice: BenchLattice, n: [usize; 3], collision: Collision) -> Result<(Box<dyn Vortex>, [f64; 2]), BenchError> {
+    let k = [2.0 * std::f64::consts::PI / n[0] as f64, 2.0 * std::f64::consts::PI / n[1] as f64];
+    let s: Box<dyn Vortex> = match lattice {
+        BenchLattice::D2q9 => {
+            let mut cfg = D2q9Config::new(n[0], n[1], TAU, Sides::periodic());
+            cfg.collision = collision;
+            cfg.check_interval = 0;
+            let mut s = D2q9::new(cfg, vec![])?;
+            s.init_with(|x, y| {
+                (
+                    1.0,
+                    -U0 * (k[0] * x).cos() * (k[1] * y).sin(),
+                    U0 * k[0] / k[1] * (k[0] * x).sin() * (k[1] * y).cos(),
+                )
+            });
+            Box::new(s)
+        }
+        BenchLattice::D3q19 => vortex_3d::<19, D3q19>(n, collision, k)?,
+        BenchLattice::D3q27 => vortex_3d::<27, D3q27>(n, collision, k)?,
+    };
+    Ok((s, k))
 }
 
 /// Runs the benchmark; every size is checked against the exact Taylor-Green decay before the
@@ -92,15 +208,17 @@ fn taylor_green(nx: usize, ny: usize, collision: Collision) -> Result<(D2q9, f64
 pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Result<BenchReport, BenchError> {
     let mut rows = Vec::new();
     let n_sizes = opts.sizes.len();
+    let bytes = opts.lattice.bytes_per_cell();
     for &threads in &opts.threads {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
-        for (k, &(nx, ny)) in opts.sizes.iter().enumerate() {
+        for (k, &n) in opts.sizes.iter().enumerate() {
+            let [nx, ny, nz] = n;
             // The copy is measured right before each row (best of 5), and the kernel is timed as
             // the best of 3 runs, so both see the machine in the same state (this VM's
             // bandwidth moves by +-20 % between minutes).
             let copy_gbs = pool.install(|| stream_copy_gbs(opts.stream_values, 5));
             let row = pool.install(|| -> Result<BenchRow, BenchError> {
-                let (mut s, rate, kx, ky) = taylor_green(nx, ny, opts.collision)?;
+                let (mut s, kw) = taylor_green(opts.lattice, n, opts.collision)?;
                 s.advance(3)?;
                 // Calibrate the step count to the time budget.
                 let t = Instant::now();
@@ -114,27 +232,27 @@ pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Resu
                     dt = dt.min(t.elapsed().as_secs_f64());
                 }
                 // Check: velocity against the exact decay u0 exp(-nu k^2 t).
-                let time = s.time() as f64;
-                let amp = 0.02 * (-rate * time).exp();
+                let rate = (TAU - 0.5) / 3.0 * (kw[0] * kw[0] + kw[1] * kw[1]);
+                let amp = U0 * (-rate * s.time() as f64).exp();
                 let mut err = 0.0f64;
                 for y in (0..ny).step_by((ny / 16).max(1)) {
                     for x in (0..nx).step_by((nx / 16).max(1)) {
-                        let (_, u, _) = s.node(x, y);
-                        let exact = -amp * (kx * x as f64).cos() * (ky * y as f64).sin();
-                        err = err.max((u as f64 - exact).abs() / 0.02);
+                        let exact = -amp * (kw[0] * x as f64).cos() * (kw[1] * y as f64).sin();
+                        err = err.max((s.u(x, y) - exact).abs() / U0);
                     }
                 }
-                let mlups = (nx * ny) as f64 * steps as f64 / dt / 1e6;
-                let kernel_gbs = mlups * 1e6 * BYTES_PER_CELL_F32 as f64 / 1e9;
-                let roofline = copy_gbs * 1e9 / BYTES_PER_CELL_F32 as f64 / 1e6;
+                let cells = (nx * ny * nz) as f64;
+                let mlups = cells * steps as f64 / dt / 1e6;
+                let roofline = copy_gbs * 1e9 / bytes as f64 / 1e6;
                 Ok(BenchRow {
                     nx,
                     ny,
-                    megabytes: (nx * ny * BYTES_PER_CELL_F32) as f64 / 1e6,
+                    nz,
+                    megabytes: cells * bytes as f64 / 1e6,
                     threads,
                     collision: opts.collision.name().into(),
                     mlups,
-                    kernel_gbs,
+                    kernel_gbs: mlups * 1e6 * bytes as f64 / 1e9,
                     copy_gbs,
                     roofline_mlups: roofline,
                     roofline_fraction: mlups / roofline,
@@ -142,14 +260,16 @@ pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Resu
                     memory_bound: k + 1 == n_sizes,
                 })
             })?;
+            let grid = grid_name(&row);
             if row.check_error > 0.01 {
                 return Err(BenchError::Check(format!(
-                    "{nx} x {ny}: Taylor-Green velocity off by {:.2e} of its amplitude",
+                    "{grid}: Taylor-Green velocity off by {:.2e} of its amplitude",
                     row.check_error
                 )));
             }
             progress(&format!(
-                "{nx} x {ny}, {threads} thread(s): {:.0} MLUPS ({:.0} % of roofline)",
+                "{} {grid}, {threads} thread(s): {:.0} MLUPS ({:.0} % of roofline)",
+                opts.lattice.name(),
                 row.mlups,
                 100.0 * row.roofline_fraction
             ));
@@ -159,7 +279,10 @@ pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Resu
     // The target applies to the whole machine (the most threads) at the memory-bound size: with
     // fewer cores than the memory system can feed, the kernel is bound by arithmetic (its
     // single-thread rate in the last-level cache is no higher than from memory).
-    let target = 0.7;
+    let target = match opts.lattice {
+        BenchLattice::D2q9 => 0.7,
+        _ => 0.8,
+    };
     let max_threads = rows.iter().map(|r| r.threads).max().unwrap_or(1);
     let pass = rows
         .iter()
@@ -167,7 +290,8 @@ pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Resu
         .all(|r| r.roofline_fraction >= target);
     Ok(BenchReport {
         schema: "hgym/bench-lbm/v1".into(),
-        bytes_per_cell: BYTES_PER_CELL_F32,
+        lattice: opts.lattice,
+        bytes_per_cell: bytes,
         rows,
         target_fraction: target,
         pass,
@@ -175,11 +299,21 @@ pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Resu
     })
 }
 
+fn grid_name(r: &BenchRow) -> String {
+    if r.nz > 1 {
+        format!("{}x{}x{}", r.nx, r.ny, r.nz)
+    } else {
+        format!("{}x{}", r.nx, r.ny)
+    }
+}
+
 impl BenchReport {
     pub fn table(&self) -> String {
         let mut s = format!(
-            "D2Q9 FP32 step, {} bytes per cell update; roofline = STREAM copy bandwidth / {}\n",
-            self.bytes_per_cell, self.bytes_per_cell
+            "{} FP32 step, {} bytes per cell update; roofline = STREAM copy bandwidth / {}\n",
+            self.lattice.name().to_uppercase(),
+            self.bytes_per_cell,
+            self.bytes_per_cell
         );
         s += &format!(
             "  {:>11} {:>9} {:>7} {:>9} {:>10} {:>10} {:>10} {:>9}  {}\n",
@@ -188,7 +322,7 @@ impl BenchReport {
         for r in &self.rows {
             s += &format!(
                 "  {:>11} {:>9.1} {:>7} {:>9.1} {:>10.2} {:>10.2} {:>10.1} {:>8.0}%  TG err {:.1e}{}\n",
-                format!("{}x{}", r.nx, r.ny),
+                grid_name(r),
                 r.megabytes,
                 r.threads,
                 r.mlups,

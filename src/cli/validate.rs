@@ -136,6 +136,15 @@ fn run_cases(cases: &[LoadedCase], args: &ValidateArgs, out: &std::path::Path) -
     let mut reports = Vec::new();
     for c in cases {
         let plan = validate::plan(c, args.level)?;
+        if !args.json {
+            eprintln!(
+                "{} ({}): {}, {} steps",
+                c.case.case.name,
+                args.level.name(),
+                plan.flow.describe(),
+                plan.total_steps
+            );
+        }
         let pb = Progress::new(plan.total_steps, &c.case.case.name);
         let report = pool
             .install(|| validate::validate_case(c, &opts, &mut |done, _| pb.set_position(done)))

@@ -260,6 +260,7 @@ impl EnvSpec {
             resolution: self.resolution.clone(),
             sponges: self.sponge.iter().map(|s| (**s).clone()).collect(),
             refinement: None,
+            span: None,
         }
     }
 

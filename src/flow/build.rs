@@ -30,6 +30,12 @@ impl FlowSetup {
     /// the characteristic inlet, the bodies, and the refined patches if the plan has them. The
     /// fluid is left at rest with unit density; callers set their initial state.
     pub fn build(&self, plan: &FlowPlan) -> Result<LbmFlow, FlowError> {
+        if self.span.is_some() {
+            return Err(FlowError::Invalid {
+                field: "span",
+                message: "a 3D flow (it has a span); build it with `build3`".into(),
+            });
+        }
         let n = plan.units.cells_per_length;
         let u = self.lattice_velocity;
         let ny = plan.ny;

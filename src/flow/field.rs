@@ -33,3 +33,23 @@ pub fn vorticity_field(s: &D2q9, units: &Units, extent: [f64; 4]) -> Field {
     }
     Field { nx, ny, extent, values: w }
 }
+
+/// Spanwise vorticity `w_z = dv/dx - du/dy` in the mid-span plane of a 3D flow (central
+/// differences, units of U/L; NaN in bodies).
+pub fn mid_span_vorticity(s: &super::LbmFlow3, units: &Units, extent: [f64; 4]) -> Field {
+    let [nx, ny, nz] = s.n();
+    let z = nz / 2;
+    let mut w = vec![f32::NAN; nx * ny];
+    let u = |x: usize, y: usize| s.rho_u([x, y, z]).1;
+    for y in 1..ny.saturating_sub(1) {
+        for x in 1..nx.saturating_sub(1) {
+            if s.is_solid([x, y, z]) {
+                continue;
+            }
+            let dvdx = 0.5 * (u(x + 1, y)[1] - u(x - 1, y)[1]);
+            let dudy = 0.5 * (u(x, y + 1)[0] - u(x, y - 1)[0]);
+            w[y * nx + x] = units.vorticity(dvdx - dudy) as f32;
+        }
+    }
+    Field { nx, ny, extent, values: w }
+}

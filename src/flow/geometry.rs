@@ -38,6 +38,18 @@ pub enum GeometrySpec {
         length: f64,
         depth: f64,
     },
+    /// A sphere (3D flows only); reference length: the diameter.
+    Sphere {
+        #[serde(deserialize_with = "super::triple")]
+        center: [f64; 3],
+        diameter: f64,
+    },
+    /// An axis-aligned cube (3D flows only); reference length: the side.
+    Cube {
+        #[serde(deserialize_with = "super::triple")]
+        center: [f64; 3],
+        side: f64,
+    },
     /// A cosine constriction of a straight channel (the domain's walls) with its throat at
     /// `center`; reference length: the channel width.
     Stenosis {
@@ -104,6 +116,16 @@ impl GeometrySpec {
                 positive("length", *length)?;
                 positive("depth", *depth)
             }
+            GeometrySpec::Sphere { center, diameter } => {
+                finite("center", &[center[0], center[1]])?;
+                finite("center", &[center[2], 0.0])?;
+                positive("diameter", *diameter)
+            }
+            GeometrySpec::Cube { center, side } => {
+                finite("center", &[center[0], center[1]])?;
+                finite("center", &[center[2], 0.0])?;
+                positive("side", *side)
+            }
             GeometrySpec::Stenosis {
                 center,
                 width,
@@ -123,6 +145,19 @@ impl GeometrySpec {
         }
     }
 
+    /// The shape's name as set-ups spell it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            GeometrySpec::Circle { .. } => "circle",
+            GeometrySpec::Square { .. } => "square",
+            GeometrySpec::Naca { .. } => "naca",
+            GeometrySpec::Cavity { .. } => "cavity",
+            GeometrySpec::Stenosis { .. } => "stenosis",
+            GeometrySpec::Sphere { .. } => "sphere",
+            GeometrySpec::Cube { .. } => "cube",
+        }
+    }
+
     pub fn reference_length(&self) -> f64 {
         match self {
             GeometrySpec::Circle { diameter, .. } => *diameter,
@@ -130,6 +165,8 @@ impl GeometrySpec {
             GeometrySpec::Naca { chord, .. } => *chord,
             GeometrySpec::Cavity { depth, .. } => *depth,
             GeometrySpec::Stenosis { width, .. } => *width,
+            GeometrySpec::Sphere { diameter, .. } => *diameter,
+            GeometrySpec::Cube { side, .. } => *side,
         }
     }
 
@@ -149,6 +186,7 @@ impl GeometrySpec {
     pub fn center(&self) -> [f64; 2] {
         match self {
             GeometrySpec::Circle { center, .. } | GeometrySpec::Square { center, .. } | GeometrySpec::Stenosis { center, .. } => *center,
+            GeometrySpec::Sphere { center, .. } | GeometrySpec::Cube { center, .. } => [center[0], center[1]],
             GeometrySpec::Naca { chord, leading_edge, .. } => [leading_edge[0] + 0.5 * chord, leading_edge[1]],
             GeometrySpec::Cavity {
                 leading_edge,
@@ -163,13 +201,42 @@ impl GeometrySpec {
     pub fn is_immersed(&self) -> bool {
         matches!(
             self,
-            GeometrySpec::Circle { .. } | GeometrySpec::Square { .. } | GeometrySpec::Naca { .. }
+            GeometrySpec::Circle { .. }
+                | GeometrySpec::Square { .. }
+                | GeometrySpec::Naca { .. }
+                | GeometrySpec::Sphere { .. }
+                | GeometrySpec::Cube { .. }
         )
     }
 
-    /// The body as the solver's signed-distance shape.
+    /// Whether the body only exists in 3D (a sphere, a cube): the others are 2D sections,
+    /// extruded along the span in a 3D flow.
+    pub fn is_3d_only(&self) -> bool {
+        matches!(self, GeometrySpec::Sphere { .. } | GeometrySpec::Cube { .. })
+    }
+
+    /// The body's extent along z `[z0, z1]` (3D-only bodies), `None` for a section extruded
+    /// along the whole span.
+    pub fn z_extent(&self) -> Option<[f64; 2]> {
+        match self {
+            GeometrySpec::Sphere { center, diameter } => Some([center[2] - 0.5 * diameter, center[2] + 0.5 * diameter]),
+            GeometrySpec::Cube { center, side } => Some([center[2] - 0.5 * side, center[2] + 0.5 * side]),
+            _ => None,
+        }
+    }
+
+    /// The body as the solver's signed-distance shape (for a sphere or a cube, its section
+    /// through the centre, which gives its x-y extent).
     pub fn shape(&self) -> Arc<dyn Shape> {
         match self {
+            GeometrySpec::Sphere { center, diameter } => Arc::new(Circle {
+                center: [center[0], center[1]],
+                radius: 0.5 * diameter,
+            }),
+            GeometrySpec::Cube { center, side } => Arc::new(Rectangle {
+                center: [center[0], center[1]],
+                size: [*side, *side],
+            }),
             GeometrySpec::Circle { center, diameter } => Arc::new(Circle {
                 center: *center,
                 radius: 0.5 * diameter,

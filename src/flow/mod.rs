@@ -19,6 +19,7 @@ pub mod geometry;
 pub mod inlet;
 pub mod level;
 pub mod plan;
+pub mod span;
 
 use serde::{Deserialize, Deserializer, Serialize};
 use thiserror::Error;
@@ -27,11 +28,12 @@ use hgym_solvers::lbm::{Collision, LbmError};
 
 pub use build::LbmFlow;
 pub use domain::{BoundaryKind, BoundarySpec, DomainSpec, EdgeName, SpongeSpec};
-pub use field::{vorticity_field, Field};
+pub use field::{mid_span_vorticity, vorticity_field, Field};
 pub use geometry::GeometrySpec;
 pub use inlet::{InletSpec, Profile, VelocityReference};
 pub use level::{Level, ResolutionSpec, UnknownLevel};
 pub use plan::{FlowPlan, RefinementPlan, RefinementSpec, MAX_LATTICE_SPEED, MAX_NODES};
+pub use span::{Lattice3Name, LbmFlow3, SpanSpec};
 
 /// `[a, b]` and nothing else: TOML readers fill a fixed-size array from the front and drop what
 /// follows, so `x = [0, 60, 90]` would silently lose its third number.
@@ -41,6 +43,12 @@ pub fn pair<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
 
 fn exactly_two<E: serde::de::Error>(v: &[f64]) -> Result<[f64; 2], E> {
     <[f64; 2]>::try_from(v).map_err(|_| E::invalid_length(v.len(), &"two numbers [a, b]"))
+}
+
+/// `[a, b, c]` and nothing else (see [`pair`]).
+pub fn triple<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
+    let v = Vec::<f64>::deserialize(d)?;
+    <[f64; 3]>::try_from(v.as_slice()).map_err(|_| serde::de::Error::invalid_length(v.len(), &"three numbers [x, y, z]"))
 }
 
 /// A list of `[a, b]` pairs, each checked as [`pair`] checks one.
@@ -85,6 +93,10 @@ pub struct FlowSetup {
     pub resolution: ResolutionSpec,
     pub sponges: Vec<SpongeSpec>,
     pub refinement: Option<RefinementSpec>,
+    /// The span of a 3D flow; `None` for a 2D one (left out of the JSON form, so 2D set-ups
+    /// hash as before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub span: Option<SpanSpec>,
 }
 
 impl FlowSetup {
@@ -94,6 +106,18 @@ impl FlowSetup {
         // Plain fields with string keys: serialising to JSON cannot fail.
         let json = serde_json::to_string(self).expect("a flow set-up serialises to JSON");
         format!("{:x}", Sha256::digest(json.as_bytes()))
+    }
+
+    /// The area the force coefficients divide by, in L^2: in 3D the span times L for a body along
+    /// the whole span, the frontal area for a sphere (pi/4) or a cube (1); 1 in 2D, where forces
+    /// are per unit span (L times one lattice spacing in the solver's units).
+    pub fn reference_area(&self) -> f64 {
+        match (&self.span, self.bodies.first()) {
+            (None, _) => 1.0,
+            (Some(_), Some(GeometrySpec::Sphere { .. })) => std::f64::consts::FRAC_PI_4,
+            (Some(_), Some(GeometrySpec::Cube { .. })) => 1.0,
+            (Some(span), _) => span.length() / self.reference_length(),
+        }
     }
 
     /// The reference length L (body 0's), or 1 for a flow without bodies.
@@ -198,6 +222,48 @@ impl FlowSetup {
         }
         if let Some(rf) = &self.refinement {
             rf.check(d)?;
+        }
+        match &self.span {
+            None => {
+                if let Some(g) = self.bodies.iter().find(|g| g.is_3d_only()) {
+                    return Err(bad(
+                        "bodies",
+                        format!("a {} needs a 3D flow: give the set-up a span ([span] z = [z0, z1])", g.name()),
+                    ));
+                }
+            }
+            Some(span) => {
+                span.check()?;
+                if self.refinement.is_some() {
+                    return Err(bad("refinement", "3D flows run on one uniform grid; remove the refinement regions"));
+                }
+                if !self.sponges.is_empty() {
+                    return Err(bad("sponge", "3D flows have no absorbing layers yet; remove the sponge layers"));
+                }
+                if self.inlet.profile != Profile::Uniform || self.inlet.characteristic_time > 0.0 {
+                    return Err(bad(
+                        "inlet",
+                        "a 3D inlet is uniform and rigid: use profile = \"uniform\" and characteristic_time = 0",
+                    ));
+                }
+                let dz = l / r.coarse.min(r.default).min(r.fine) as f64;
+                for (i, g) in self.bodies.iter().enumerate() {
+                    if let Some([z0, z1]) = g.z_extent() {
+                        if z0 < span.z[0] + 2.0 * dz || z1 > span.z[1] - 2.0 * dz {
+                            return Err(bad(
+                                "bodies",
+                                format!(
+                                    "body {} spans z [{z0:.3}, {z1:.3}], which does not fit inside the span [{}, {}] with two cells \
+                                     to spare (a body may not cross a periodic face): enlarge the span or move the body",
+                                    i + 1,
+                                    span.z[0],
+                                    span.z[1]
+                                ),
+                            ));
+                        }
+                    }
+                }
+            }
         }
         // Immersed bodies inside the domain, two cells from every edge even at the coarsest level.
         let dx = l / r.coarse.min(r.default).min(r.fine) as f64;

@@ -84,6 +84,11 @@ pub struct FlowPlan {
     pub units: Units,
     pub nx: usize,
     pub ny: usize,
+    /// Nodes along the span of a 3D flow (`None` in 2D).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nz: Option<usize>,
+    /// Bytes of populations per node (two copies of Q f32 values).
+    pub bytes_per_node: usize,
     /// Grid spacing in the set-up's length units (`L / cells_per_length`).
     pub dx: f64,
     pub tau: f64,
@@ -91,6 +96,26 @@ pub struct FlowPlan {
     pub collision: Collision,
     /// The nested patches, if the set-up has refinement regions.
     pub refinement: Option<RefinementPlan>,
+}
+
+impl FlowPlan {
+    /// One line for people: the grid, its memory, tau and Mach.
+    pub fn describe(&self) -> String {
+        let cells = (self.nx * self.ny * self.nz.unwrap_or(1)) as f64;
+        let grid = match self.nz {
+            Some(nz) => format!("{} x {} x {nz}", self.nx, self.ny),
+            None => format!("{} x {}", self.nx, self.ny),
+        };
+        format!(
+            "{grid} nodes ({:.2} million, {:.2} GB of populations), {} cells per L, tau {:.4}, Mach {:.3}, {}",
+            cells / 1e6,
+            cells * self.bytes_per_node as f64 / 1e9,
+            self.units.cells_per_length,
+            self.tau,
+            self.mach,
+            self.collision.name()
+        )
+    }
 }
 
 impl FlowSetup {
@@ -123,16 +148,26 @@ impl FlowSetup {
         let d = &self.domain;
         let nx_f = (d.x[1] - d.x[0]) * n / l;
         let ny_f = (d.y[1] - d.y[0]) * n / l;
+        let nz = match &self.span {
+            Some(span) => Some(span.nodes(n / l, level.name())?),
+            None => None,
+        };
+        let bytes = self.span.as_ref().map_or(BYTES_PER_NODE, |s| s.lattice.bytes_per_node());
+        let nz_f = nz.unwrap_or(1) as f64;
         // Compared as floats first: a huge domain must not wrap when cast to usize.
-        if !(nx_f * ny_f <= MAX_NODES as f64) {
+        let max_bytes = (MAX_NODES * BYTES_PER_NODE) as f64;
+        if !(nx_f * ny_f * nz_f * bytes as f64 <= max_bytes) {
+            let cells = match nz {
+                Some(nz) => format!("{} x {} x {nz}", count(nx_f), count(ny_f)),
+                None => format!("{} x {}", count(nx_f), count(ny_f)),
+            };
             return Err(FlowError::Invalid {
                 field: "resolution",
                 message: format!(
-                    "{} x {} cells would need {} GB of populations ({BYTES_PER_NODE} bytes per cell); the limit is {MAX_NODES} cells ({:.1} GB): use a coarser level or a smaller domain",
-                    count(nx_f),
-                    count(ny_f),
-                    count(nx_f * ny_f * BYTES_PER_NODE as f64 / 1e9),
-                    (MAX_NODES * BYTES_PER_NODE) as f64 / 1e9
+                    "{cells} cells would need {} GB of populations ({bytes} bytes per cell); the limit is {} cells ({:.1} GB): use a coarser level or a smaller domain",
+                    count(nx_f * ny_f * nz_f * bytes as f64 / 1e9),
+                    (max_bytes as usize) / bytes,
+                    max_bytes / 1e9
                 ),
             });
         }
@@ -143,7 +178,7 @@ impl FlowSetup {
                 message: format!("{nx} x {ny} cells is too small; enlarge the domain or the resolution"),
             });
         }
-        if nx * ny > MAX_NODES {
+        if self.span.is_none() && nx * ny > MAX_NODES {
             return Err(FlowError::Invalid {
                 field: "resolution",
                 message: format!(
@@ -182,6 +217,8 @@ impl FlowSetup {
             units,
             nx,
             ny,
+            nz,
+            bytes_per_node: bytes,
             dx: l / n,
             tau,
             mach: units.mach(),

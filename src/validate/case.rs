@@ -14,8 +14,8 @@ use sha2::{Digest, Sha256};
 use hgym_solvers::lbm::Collision;
 
 pub use crate::flow::{
-    BoundaryKind, BoundarySpec, DomainSpec, EdgeName, GeometrySpec, InletSpec, Level, Profile, RefinementSpec, ResolutionSpec, SpongeSpec,
-    VelocityReference, MAX_LATTICE_SPEED, MAX_NODES,
+    BoundaryKind, BoundarySpec, DomainSpec, EdgeName, GeometrySpec, InletSpec, Level, Profile, RefinementSpec, ResolutionSpec, SpanSpec,
+    SpongeSpec, VelocityReference, MAX_LATTICE_SPEED, MAX_NODES,
 };
 use crate::flow::{FlowError, FlowSetup};
 
@@ -73,6 +73,9 @@ pub struct Case {
     /// twice as fine, coupled to the grid of the level (see `hgym_solvers::lbm::Refined`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub refinement: Option<RefinementSpec>,
+    /// The span of a 3D case (`[span]`): z range, spanwise faces, segments, velocity set.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub span: Option<SpanSpec>,
     #[serde(default)]
     pub reference: Vec<ReferenceSpec>,
 }
@@ -231,6 +234,7 @@ impl Case {
             resolution: self.resolution.clone(),
             sponges: self.sponge.clone(),
             refinement: self.refinement.clone(),
+            span: self.span.clone(),
         }
     }
 }

@@ -40,6 +40,9 @@ pub struct Parameters {
     pub mach: f64,
     pub nx: usize,
     pub ny: usize,
+    /// Nodes along the span (3D cases).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nz: Option<usize>,
     pub collision: String,
     pub spin_up: f64,
     pub average: f64,
@@ -272,6 +275,7 @@ impl ValidationReport {
                 mach: p.flow.mach,
                 nx: p.flow.nx,
                 ny: p.flow.ny,
+                nz: p.flow.nz,
                 collision: p.flow.collision.name().into(),
                 spin_up: case.time.spin_up,
                 average: case.time.average,
@@ -343,13 +347,16 @@ impl ValidationReport {
     /// Plain-text table: quantity, measured, its standard error, reference, deviation, tolerance,
     /// pass/fail; then notes (failures, a broadband lift, a window too short to decide).
     pub fn table(&self) -> String {
+        let p = &self.parameters;
+        let grid = match p.nz {
+            Some(nz) => format!("{} x {} x {nz}", p.nx, p.ny),
+            None => format!("{} x {}", p.nx, p.ny),
+        };
         let mut s = format!(
-            "{} [{}] level {} ({} x {} cells, {} cells/L, tau {:.5}, Ma {:.3}): {}\n",
+            "{} [{}] level {} ({grid} cells, {} cells/L, tau {:.5}, Ma {:.3}): {}\n",
             self.case,
             self.family,
             self.level,
-            self.parameters.nx,
-            self.parameters.ny,
             self.parameters.cells_per_length,
             self.parameters.tau,
             self.parameters.mach,

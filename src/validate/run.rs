@@ -13,7 +13,8 @@ use hgym_solvers::lbm::LbmError;
 
 use super::case::{flow_error, Level, LoadedCase};
 use super::ValidateError;
-use crate::flow::{vorticity_field, Field, FlowPlan};
+use crate::flow::{mid_span_vorticity, vorticity_field, Field, FlowError, FlowPlan, FlowSetup, LbmFlow, LbmFlow3};
+use hgym_solvers::lbm::Units;
 
 /// Most lattice steps a case may run (its force series hold 8 bytes per step and series).
 pub const MAX_STEPS: u64 = 20_000_000;
@@ -102,7 +103,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     let d = &case.domain;
     let steps_per_time = n / u;
     let n_bodies = setup.bodies.len();
-    let mut solver = setup.build(&plan.flow).map_err(|e| flow_error(&case.case.name, e))?;
+    let mut solver = Solver::build(&setup, &plan.flow).map_err(|e| flow_error(&case.case.name, e))?;
 
     // Initial state: the inflow everywhere, plus a transverse kick just behind the body, centred
     // a quarter length off the axis on the side of its sign: a negative perturbation is the exact
@@ -113,7 +114,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     let side = if case.flow.perturbation < 0.0 { -1.0 } else { 1.0 };
     let ramp = case.inlet.ramp;
     let start_u = if ramp > 0.0 { 0.0 } else { 1.0 };
-    solver.init_with(|x, y| {
+    solver.init_with(&|x, y| {
         let r2 = ((x - center[0] - l) / l).powi(2) + ((y - center[1] - side * 0.25 * l) / l).powi(2);
         (1.0, start_u * setup.inlet_velocity(y), kick * (-4.0 * r2).exp())
     });
@@ -124,7 +125,13 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     let mut cl = Vec::with_capacity(total as usize);
     let mut cd_bodies = vec![Vec::with_capacity(total as usize); n_bodies];
     let mut cl_bodies = vec![Vec::with_capacity(total as usize); n_bodies];
-    let coef = 0.5 * u * u * n;
+    // F / (rho U^2 A / 2) in lattice units: A = L per unit (lattice) span in 2D, the reference
+    // area (in L^2) times n^2 in 3D.
+    let area = match setup.span {
+        None => n,
+        Some(_) => setup.reference_area() * n * n,
+    };
+    let coef = 0.5 * u * u * area;
     let started = Instant::now();
     let mut status = RunStatus::Completed;
     let report_every = 250u64;
@@ -140,7 +147,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
         }
         if let Err(e) = solver.step() {
             let step = match &e {
-                LbmError::Diverged { step, .. } => *step,
+                LbmError::Diverged { step, .. } | LbmError::Diverged3 { step, .. } => *step,
                 _ => s + 1,
             };
             status = RunStatus::Diverged {
@@ -149,14 +156,16 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
             };
             break;
         }
-        let forces = solver.body_forces();
         t.push((s + 1) as f64 / steps_per_time);
-        cd.push(forces.iter().map(|f| f[0]).sum::<f64>() / coef);
-        cl.push(forces.iter().map(|f| f[1]).sum::<f64>() / coef);
-        for (b, f) in forces.iter().enumerate() {
-            cd_bodies[b].push(f[0] / coef);
-            cl_bodies[b].push(f[1] / coef);
-        }
+        let (mut sum_x, mut sum_y) = (0.0, 0.0);
+        solver.each_force(&mut |b, fx, fy| {
+            sum_x += fx;
+            sum_y += fy;
+            cd_bodies[b].push(fx / coef);
+            cl_bodies[b].push(fy / coef);
+        });
+        cd.push(sum_x / coef);
+        cl.push(sum_y / coef);
         if (s + 1) % report_every == 0 {
             progress(s + 1, total);
         }
@@ -165,8 +174,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     let wall = started.elapsed().as_secs_f64();
     let steps = solver.time();
     let mlups = (solver.node_updates_per_step() as f64 * steps as f64) / wall.max(1e-9) / 1e6;
-    solver.sync();
-    let vorticity = vorticity_field(solver.coarse(), &plan.flow.units, [d.x[0], d.x[1], d.y[0], d.y[1]]);
+    let vorticity = solver.vorticity(&plan.flow.units, [d.x[0], d.x[1], d.y[0], d.y[1]]);
     Ok(RunOutput {
         plan: plan.clone(),
         t,
@@ -180,4 +188,77 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
         steps,
         mlups,
     })
+}
+
+/// The solver a case runs on: a 2D flow (uniform or refined) or a 3D one.
+enum Solver {
+    Flat(LbmFlow),
+    Span(LbmFlow3),
+}
+
+impl Solver {
+    fn build(setup: &FlowSetup, plan: &FlowPlan) -> Result<Self, FlowError> {
+        match setup.span {
+            None => setup.build(plan).map(Solver::Flat),
+            Some(_) => setup.build3(plan).map(Solver::Span),
+        }
+    }
+
+    /// Every node at `field(x, y) = (rho, u, v)` (uniform along the span).
+    fn init_with(&mut self, field: &dyn Fn(f64, f64) -> (f64, f64, f64)) {
+        match self {
+            Solver::Flat(s) => s.init_with(field),
+            Solver::Span(s) => s.init_with(|p| {
+                let (rho, u, v) = field(p[0], p[1]);
+                (rho, [u, v, 0.0])
+            }),
+        }
+    }
+
+    fn set_boundary_velocity_scale(&mut self, scale: f64) {
+        match self {
+            Solver::Flat(s) => s.set_boundary_velocity_scale(scale),
+            Solver::Span(s) => s.set_boundary_velocity_scale(scale),
+        }
+    }
+
+    fn step(&mut self) -> Result<(), LbmError> {
+        match self {
+            Solver::Flat(s) => s.step(),
+            Solver::Span(s) => s.step(),
+        }
+    }
+
+    /// Streamwise and transverse (y) force on each body in turn, lattice units.
+    fn each_force(&self, f: &mut dyn FnMut(usize, f64, f64)) {
+        match self {
+            Solver::Flat(s) => s.body_forces().iter().enumerate().for_each(|(b, v)| f(b, v[0], v[1])),
+            Solver::Span(s) => s.body_forces().iter().enumerate().for_each(|(b, v)| f(b, v[0], v[1])),
+        }
+    }
+
+    fn time(&self) -> u64 {
+        match self {
+            Solver::Flat(s) => s.time(),
+            Solver::Span(s) => s.time(),
+        }
+    }
+
+    fn node_updates_per_step(&self) -> usize {
+        match self {
+            Solver::Flat(s) => s.node_updates_per_step(),
+            Solver::Span(s) => s.n().iter().product(),
+        }
+    }
+
+    /// The final vorticity: of the whole (coarse) grid in 2D, of the mid-span plane in 3D.
+    fn vorticity(&mut self, units: &Units, extent: [f64; 4]) -> Field {
+        match self {
+            Solver::Flat(s) => {
+                s.sync();
+                vorticity_field(s.coarse(), units, extent)
+            }
+            Solver::Span(s) => mid_span_vorticity(s, units, extent),
+        }
+    }
 }

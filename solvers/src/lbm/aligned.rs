@@ -8,15 +8,27 @@ pub(crate) struct AlignedVec {
     data: Vec<f32>,
     off: usize,
     len: usize,
+    pad: usize,
 }
 
 impl AlignedVec {
     pub fn zeros(len: usize) -> Self {
-        let data = vec![0.0f32; len + 16];
-        // `data` is 4-byte aligned, so the distance to the next 64-byte boundary is a multiple
-        // of 4 bytes, i.e. a whole number of floats, at most 15.
-        let off = ((64 - data.as_ptr() as usize % 64) % 64) / 4;
-        AlignedVec { data, off, len }
+        Self::zeros_padded(len, 0)
+    }
+
+    /// `len` values with `pad` zeros before and after them that [`AlignedVec::padded`] exposes
+    /// (kernels that read a little past a row's ends without a bounds branch).
+    pub fn zeros_padded(len: usize, pad: usize) -> Self {
+        let data = vec![0.0f32; len + 2 * pad + 16];
+        // `data` is 4-byte aligned, so the distance from `data[pad]` to the next 64-byte boundary
+        // is a multiple of 4 bytes, i.e. a whole number of floats, at most 15.
+        let off = pad + ((64 - data[pad..].as_ptr() as usize % 64) % 64) / 4;
+        AlignedVec { data, off, len, pad }
+    }
+
+    /// The values with their padding: element `k` of the vector is element `k + pad` here.
+    pub fn padded(&self) -> &[f32] {
+        &self.data[self.off - self.pad..self.off + self.len + self.pad]
     }
 }
 
@@ -43,6 +55,10 @@ mod tests {
             let v = AlignedVec::zeros(len);
             assert_eq!(v.as_ptr() as usize % 64, 0);
             assert_eq!(v.len(), len);
+            let p = AlignedVec::zeros_padded(len, 16);
+            assert_eq!(p.as_ptr() as usize % 64, 0);
+            assert_eq!(p.padded().len(), len + 32);
+            assert_eq!(p.padded()[16..].as_ptr(), p.as_ptr());
         }
     }
 }

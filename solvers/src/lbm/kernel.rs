@@ -103,7 +103,7 @@ impl KernelCtx<'_> {
 /// of 8 floats long, and the row starting on a 32-byte boundary (the arrays are cache-line
 /// aligned, see `AlignedVec`).
 #[inline]
-fn nt_rows_possible(row: &[f32], nx: usize) -> bool {
+pub(crate) fn nt_rows_possible(row: &[f32], nx: usize) -> bool {
     cfg!(all(target_arch = "x86_64", target_feature = "avx")) && nx.is_multiple_of(8) && (row.as_ptr() as usize).is_multiple_of(32)
 }
 
@@ -231,7 +231,7 @@ fn bulk_row_streamed<const OP: u8, const FORCED: bool, const LES: bool>(c: &Kern
 /// `dst.copy_from_slice(src)` with aligned 8-wide non-temporal stores (`vmovntps`). The caller
 /// guarantees `dst` starts on a 32-byte boundary and has a length that is a multiple of 8.
 #[inline(always)]
-fn stream_aligned(dst: &mut [f32], src: &[f32]) {
+pub(crate) fn stream_aligned(dst: &mut [f32], src: &[f32]) {
     assert_eq!(dst.len(), src.len());
     #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
     {
@@ -257,7 +257,7 @@ fn stream_aligned(dst: &mut [f32], src: &[f32]) {
 /// so the general path's ordinary stores to the edge nodes land after them and other threads
 /// see the row once the step's join completes.
 #[inline(always)]
-fn store_fence() {
+pub(crate) fn store_fence() {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
     // SAFETY: `sfence` takes no operands, touches no memory and cannot fault.
     unsafe {

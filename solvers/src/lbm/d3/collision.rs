@@ -17,6 +17,8 @@
 //! The recursive-regularised terms of the 2D kernel are not carried over: D3Q19 lacks `H_xyz`
 //! and the fourth-order polynomials, so the recursion would be incomplete there.
 
+use wide::f32x8;
+
 use super::super::collision::{Relax, OMEGA_BULK, OP_BGK};
 use super::lattice::Lattice3;
 
@@ -28,8 +30,8 @@ pub fn moments<const Q: usize, L: Lattice3<Q>>(g: &[f32; Q]) -> (f32, [f32; 3]) 
     for i in 0..Q {
         drho += g[i];
         for a in 0..3 {
-            if L::C[i][a] != 0 {
-                j[a] += L::C[i][a] as f32 * g[i];
+            if L::C_REF[i][a] != 0 {
+                j[a] += L::C_REF[i][a] as f32 * g[i];
             }
         }
     }
@@ -43,9 +45,9 @@ pub fn equilibrium<const Q: usize, L: Lattice3<Q>>(drho: f32, u: [f32; 3]) -> [f
     let usq = 1.5 * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
     let mut e = [0.0f32; Q];
     for i in 0..Q {
-        let c = L::C[i];
+        let c = L::C_REF[i];
         let cu = 3.0 * (c[0] as f32 * u[0] + c[1] as f32 * u[1] + c[2] as f32 * u[2]);
-        e[i] = L::W[i] * (drho + rho * (cu + 0.5 * cu * cu - usq));
+        e[i] = L::W_REF[i] * (drho + rho * (cu + 0.5 * cu * cu - usq));
     }
     e
 }
@@ -77,7 +79,7 @@ pub fn collide<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool,
         let mut p = [0.0f32; 6];
         for i in 0..Q {
             let n = g[i] - geq[i];
-            let c = L::C[i].map(|v| v as f32);
+            let c = L::C_REF[i].map(|v| v as f32);
             p[0] += c[0] * c[0] * n;
             p[1] += c[1] * c[1] * n;
             p[2] += c[2] * c[2] * n;
@@ -103,30 +105,196 @@ pub fn collide<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool,
         ];
         let tr = q[0] + q[1] + q[2];
         for i in 0..Q {
-            let c = L::C[i].map(|v| v as f32);
+            let c = L::C_REF[i].map(|v| v as f32);
             let qpi = c[0] * c[0] * q[0]
                 + c[1] * c[1] * q[1]
                 + c[2] * c[2] * q[2]
                 + 2.0 * (c[0] * c[1] * q[3] + c[0] * c[2] * q[4] + c[1] * c[2] * q[5])
                 - (1.0 / 3.0) * tr;
-            g[i] = geq[i] + 4.5 * L::W[i] * qpi;
+            g[i] = geq[i] + 4.5 * L::W_REF[i] * qpi;
             if FORCED {
                 // First-order non-equilibrium -3 w_i c_i.F/2, relaxed by 1 - omega.
                 let cf = c[0] * f[0] + c[1] * f[1] + c[2] * f[2];
-                g[i] -= k * 1.5 * L::W[i] * cf;
+                g[i] -= k * 1.5 * L::W_REF[i] * cf;
             }
         }
     }
     if FORCED {
         let s = 1.0 - 0.5 * omega;
         for i in 0..Q {
-            let c = L::C[i].map(|v| v as f32);
+            let c = L::C_REF[i].map(|v| v as f32);
             let cu = c[0] * u[0] + c[1] * u[1] + c[2] * u[2];
             let mut sf = 0.0;
             for a in 0..3 {
                 sf += (3.0 * (c[a] - u[a]) + 9.0 * cu * c[a]) * f[a];
             }
-            g[i] += s * L::W[i] * sf;
+            g[i] += s * L::W_REF[i] * sf;
+        }
+    }
+}
+
+/// Nodes per chunk of [`collide_chunk`].
+pub const CHUNK: usize = 128;
+
+/// Nodes per vector block: one AVX register of f32.
+const LANES: usize = 8;
+
+/// The velocity set as plain values on the stack. Indexing an associated `const` array with a
+/// run-time index makes the compiler copy the whole array each time (the direction loops are
+/// not unrolled); these are built once per chunk.
+pub struct Tables<const Q: usize> {
+    c: [[f32; 3]; Q],
+    w: [f32; Q],
+}
+
+impl<const Q: usize> Tables<Q> {
+    #[inline(always)]
+    pub fn of<L: Lattice3<Q>>() -> Self {
+        Tables {
+            c: L::C.map(|c| c.map(|v| v as f32)),
+            w: L::W,
+        }
+    }
+}
+
+/// The shifted equilibrium of direction `c, w` for a block, the same expression as
+/// [`equilibrium`] in every lane.
+#[inline(always)]
+fn eq_lanes(c: [f32; 3], w: f32, drho: f32x8, rho: f32x8, u: &[f32x8; 3], usq: f32x8) -> f32x8 {
+    let cu = f32x8::splat(3.0) * (f32x8::splat(c[0]) * u[0] + f32x8::splat(c[1]) * u[1] + f32x8::splat(c[2]) * u[2]);
+    f32x8::splat(w) * (drho + rho * (cu + f32x8::splat(0.5) * cu * cu - usq))
+}
+
+/// [`collide`] for a block of [`LANES`] nodes, `g[i]` direction `i` of the eight nodes, in place,
+/// on explicit 8-wide vectors (`wide::f32x8`; the compiler left to itself shuffled lanes). The
+/// loops over directions are not unrolled (`Q` is large); the block's moments and stresses stay in
+/// registers across them. Every lane runs exactly the operations of [`collide`] in the same order
+/// (IEEE single precision, no fused multiply-add), so the results are bitwise the same.
+#[inline(always)]
+fn collide_block<const Q: usize, const OP: u8, const FORCED: bool, const LES: bool>(
+    g: &mut [f32x8; Q],
+    t: &Tables<Q>,
+    relax: Relax,
+    f: [f32; 3],
+) {
+    let splat = f32x8::splat;
+    let mut drho = splat(0.0);
+    let mut u = [splat(0.0); 3];
+    for i in 0..Q {
+        drho += g[i];
+        for a in 0..3 {
+            if t.c[i][a] != 0.0 {
+                u[a] += splat(t.c[i][a]) * g[i];
+            }
+        }
+    }
+    let rho = splat(1.0) + drho;
+    let inv_rho = splat(1.0) / rho;
+    for a in 0..3 {
+        u[a] = if FORCED {
+            (u[a] + splat(0.5 * f[a])) * inv_rho
+        } else {
+            u[a] * inv_rho
+        };
+    }
+    let usq = splat(1.5) * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    let mut omega = splat(relax.omega);
+    if OP == OP_BGK {
+        for i in 0..Q {
+            let e = eq_lanes(t.c[i], t.w[i], drho, rho, &u, usq);
+            g[i] -= omega * (g[i] - e);
+        }
+    } else {
+        let mut p = [splat(0.0); 6];
+        for i in 0..Q {
+            let c = t.c[i];
+            let n = g[i] - eq_lanes(c, t.w[i], drho, rho, &u, usq);
+            let cc = [c[0] * c[0], c[1] * c[1], c[2] * c[2], c[0] * c[1], c[0] * c[2], c[1] * c[2]];
+            for k in 0..6 {
+                p[k] += splat(cc[k]) * n;
+            }
+        }
+        if LES {
+            let norm = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] + splat(2.0) * (p[3] * p[3] + p[4] * p[4] + p[5] * p[5])).sqrt();
+            let tau0 = splat(relax.tau0);
+            let tau = splat(0.5) * (tau0 + (tau0 * tau0 + splat(relax.les) * norm * inv_rho).sqrt());
+            omega = splat(1.0) / tau;
+        }
+        let k = splat(1.0) - omega;
+        let third_tr = (p[0] + p[1] + p[2]) * splat(1.0 / 3.0);
+        let bulk = splat(1.0 - OMEGA_BULK) * third_tr;
+        for a in 0..3 {
+            p[a] = k * (p[a] - third_tr) + bulk;
+        }
+        for b in 3..6 {
+            p[b] = k * p[b];
+        }
+        let tr = p[0] + p[1] + p[2];
+        for i in 0..Q {
+            let (c, w) = (t.c[i], t.w[i]);
+            let e = eq_lanes(c, w, drho, rho, &u, usq);
+            let qpi = splat(c[0] * c[0]) * p[0]
+                + splat(c[1] * c[1]) * p[1]
+                + splat(c[2] * c[2]) * p[2]
+                + splat(2.0) * (splat(c[0] * c[1]) * p[3] + splat(c[0] * c[2]) * p[4] + splat(c[1] * c[2]) * p[5])
+                - splat(1.0 / 3.0) * tr;
+            g[i] = e + splat(4.5 * w) * qpi;
+            if FORCED {
+                let cf = c[0] * f[0] + c[1] * f[1] + c[2] * f[2];
+                g[i] -= k * splat(1.5) * splat(w) * splat(cf);
+            }
+        }
+    }
+    if FORCED {
+        let s = splat(1.0) - splat(0.5) * omega;
+        for i in 0..Q {
+            let (c, w) = (t.c[i], t.w[i]);
+            let cu = splat(c[0]) * u[0] + splat(c[1]) * u[1] + splat(c[2]) * u[2];
+            let mut sf = splat(0.0);
+            for a in 0..3 {
+                sf += (splat(3.0) * (splat(c[a]) - u[a]) + splat(9.0) * cu * splat(c[a])) * splat(f[a]);
+            }
+            g[i] += s * splat(w) * sf;
+        }
+    }
+}
+
+/// [`collide`] for `m <= CHUNK` consecutive nodes: node `k` reads direction `i` from `src[i][k]`
+/// and writes it to `out[i][k]`, in blocks of [`LANES`] nodes ([`collide_block`]); a last,
+/// partial block is padded with rest-state values that are computed and dropped.
+#[inline(always)]
+pub fn collide_chunk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
+    src: &[&[f32]; Q],
+    m: usize,
+    out: &mut [[f32; CHUNK]; Q],
+    relax: Relax,
+    f: [f32; 3],
+) {
+    let t = Tables::of::<L>();
+    let mut x = 0;
+    while x + LANES <= m {
+        let mut g = [f32x8::splat(0.0); Q];
+        for i in 0..Q {
+            let v: [f32; LANES] = src[i][x..x + LANES].try_into().expect("a block is LANES long");
+            g[i] = f32x8::new(v);
+        }
+        collide_block::<Q, OP, FORCED, LES>(&mut g, &t, relax, f);
+        for i in 0..Q {
+            out[i][x..x + LANES].copy_from_slice(&g[i].to_array());
+        }
+        x += LANES;
+    }
+    if x < m {
+        let len = m - x;
+        let mut g = [f32x8::splat(0.0); Q];
+        for i in 0..Q {
+            let mut v = [0.0f32; LANES];
+            v[..len].copy_from_slice(&src[i][x..m]);
+            g[i] = f32x8::new(v);
+        }
+        collide_block::<Q, OP, FORCED, LES>(&mut g, &t, relax, f);
+        for i in 0..Q {
+            out[i][x..m].copy_from_slice(&g[i].to_array()[..len]);
         }
     }
 }
@@ -147,8 +315,8 @@ mod tests {
         // operator's bulk rate does not enter.
         let mut g = base;
         for i in 0..Q {
-            let c = L::C[i].map(|v| v as f32);
-            g[i] += 1e-3 * L::W[i] * (c[0] * c[1] + 0.5 * (c[2] * c[2] - c[1] * c[1]));
+            let c = L::C_REF[i].map(|v| v as f32);
+            g[i] += 1e-3 * L::W_REF[i] * (c[0] * c[1] + 0.5 * (c[2] * c[2] - c[1] * c[1]));
         }
         let (m0, j0) = moments::<Q, L>(&g);
         let f = [1e-4, 2e-4, -1e-4];

@@ -16,6 +16,12 @@ pub trait Lattice3<const Q: usize>: Copy + Send + Sync + 'static {
     const W: [f32; Q];
     /// Opposite direction: `c_{OPP[i]} = -c_i`.
     const OPP: [usize; Q] = opposites(&Self::C);
+    /// The same tables behind `'static` references: indexing an associated `const` array with a
+    /// run-time index (in loops over directions that are not unrolled) copies the whole array
+    /// each time; these index static memory.
+    const C_REF: &'static [[i32; 3]; Q] = &Self::C;
+    const W_REF: &'static [f32; Q] = &Self::W;
+    const OPP_REF: &'static [usize; Q] = &Self::OPP;
     /// Bytes moved per cell update by the fused A-B kernel with FP32 storage: `Q` populations
     /// read and `Q` written (152 for D3Q19, 216 for D3Q27).
     const BYTES_PER_CELL_F32: usize = 2 * Q * 4;

@@ -65,7 +65,7 @@ impl Faces {
 /// Value entering fluid node `p` in direction `k` whose source `p - c_k` lies outside the box.
 #[inline]
 pub(crate) fn face_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p: [usize; 3], k: usize) -> f32 {
-    let ck = L::C[k];
+    let ck = L::C_REF[k];
     let s = [0, 1, 2].map(|a| p[a] as isize - ck[a] as isize);
     // The faces crossed; at an edge or corner a wall wins over an outlet, then the last axis.
     let mut face: Option<usize> = None;
@@ -82,7 +82,7 @@ pub(crate) fn face_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p
             face = Some(f);
         }
     }
-    let opp = L::OPP[k];
+    let opp = L::OPP_REF[k];
     let Some(f) = face else {
         // Not outside: cannot happen (a solid source inside the box always has a link).
         return src[c.idx::<Q>(p, opp)];
@@ -93,7 +93,7 @@ pub(crate) fn face_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p
             let g: [f32; Q] = std::array::from_fn(|i| src[c.idx::<Q>(p, i)]);
             let rho = 1.0 + moments::<Q, L>(&g).0;
             let cu = ck[0] as f32 * u[0] + ck[1] as f32 * u[1] + ck[2] as f32 * u[2];
-            src[c.idx::<Q>(p, opp)] + 6.0 * L::W[k] * rho * cu * c.velocity_scale
+            src[c.idx::<Q>(p, opp)] + 6.0 * L::W_REF[k] * rho * cu * c.velocity_scale
         }
         Face::FreeSlip => {
             // Specular reflection: the population arriving with c_k left the neighbour along the
@@ -101,7 +101,7 @@ pub(crate) fn face_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p
             let a = f / 2;
             let mut m = ck;
             m[a] = -m[a];
-            let mirrored = (0..Q).find(|&i| L::C[i] == m).unwrap_or(opp);
+            let mirrored = (0..Q).find(|&i| L::C_REF[i] == m).unwrap_or(opp);
             let mut d = ck.map(|v| -v);
             d[a] = 0;
             let b = c.neighbour(p, d).filter(|&b| !c.is_solid(b)).unwrap_or(p);
@@ -123,7 +123,7 @@ pub(crate) fn face_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p
             let u = j.map(|v| v / rho);
             let cu = 3.0 * (ck[0] as f32 * u[0] + ck[1] as f32 * u[1] + ck[2] as f32 * u[2]);
             let shape = 1.0 + cu + 0.5 * cu * cu - 1.5 * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-            g[k] - drho * L::W[k] * shape
+            g[k] - drho * L::W_REF[k] * shape
         }
     }
 }

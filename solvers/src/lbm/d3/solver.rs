@@ -6,8 +6,9 @@ use rayon::prelude::*;
 use super::super::aligned::AlignedVec;
 use super::super::collision::{Collision, Relax, OP_BGK, OP_REG};
 use super::super::error::LbmError;
+use super::super::solver::STREAM_STORES_ABOVE_BYTES;
 use super::collision::{equilibrium, moments};
-use super::kernel::{bouzidi, gather, row, Ctx, Link, Special};
+use super::kernel::{bouzidi, gather, index, plane, Ctx, Link, Special, PAD};
 use super::lattice::Lattice3;
 use super::sides::Faces;
 use crate::geometry::Solid;
@@ -51,6 +52,9 @@ pub struct D3Config {
     pub check_interval: u64,
     pub rho_bounds: [f32; 2],
     pub u_max: f32,
+    /// Non-temporal stores for the bulk: `None` decides by size (as in 2D,
+    /// [`STREAM_STORES_ABOVE_BYTES`]). A performance knob only: results are bitwise the same.
+    pub stream_stores: Option<bool>,
 }
 
 impl D3Config {
@@ -68,22 +72,23 @@ impl D3Config {
             check_interval: 100,
             rho_bounds: [0.5, 2.0],
             u_max: 0.5,
+            stream_stores: None,
         }
     }
 }
 
-/// The row kernel for one set of compile-time switches.
-type RowFn = fn(&Ctx, &[f32], usize, &mut [f32]);
+/// The plane kernel for one set of compile-time switches.
+type PlaneFn = fn(&Ctx, &[f32], &[f32], usize, &mut [f32]);
 
 /// Selects the kernel monomorphised for the operator, forcing and subgrid model.
-fn row_fn<const Q: usize, L: Lattice3<Q>>(collision: Collision, forced: bool, les: bool) -> RowFn {
+fn plane_fn<const Q: usize, L: Lattice3<Q>>(collision: Collision, forced: bool, les: bool) -> PlaneFn {
     match (collision, forced, les) {
-        (Collision::Bgk, false, _) => row::<Q, L, OP_BGK, false, false>,
-        (Collision::Bgk, true, _) => row::<Q, L, OP_BGK, true, false>,
-        (_, false, false) => row::<Q, L, OP_REG, false, false>,
-        (_, true, false) => row::<Q, L, OP_REG, true, false>,
-        (_, false, true) => row::<Q, L, OP_REG, false, true>,
-        (_, true, true) => row::<Q, L, OP_REG, true, true>,
+        (Collision::Bgk, false, _) => plane::<Q, L, OP_BGK, false, false>,
+        (Collision::Bgk, true, _) => plane::<Q, L, OP_BGK, true, false>,
+        (_, false, false) => plane::<Q, L, OP_REG, false, false>,
+        (_, true, false) => plane::<Q, L, OP_REG, true, false>,
+        (_, false, true) => plane::<Q, L, OP_REG, false, true>,
+        (_, true, true) => plane::<Q, L, OP_REG, true, true>,
     }
 }
 
@@ -112,7 +117,7 @@ struct Plan {
     links: Vec<Link>,
 }
 
-fn ctx<'a>(cfg: &'a D3Config, plan: &'a Plan, relax: Relax, velocity_scale: f32) -> Ctx<'a> {
+fn ctx<'a, const Q: usize>(cfg: &'a D3Config, plan: &'a Plan, relax: Relax, velocity_scale: f32) -> Ctx<'a> {
     Ctx {
         n: cfg.n,
         periodic: [0, 1, 2].map(|a| cfg.faces.periodic_axis(a)),
@@ -125,6 +130,9 @@ fn ctx<'a>(cfg: &'a D3Config, plan: &'a Plan, relax: Relax, velocity_scale: f32)
         row_start: &plan.row_start,
         row_bulk: &plan.row_bulk,
         links: &plan.links,
+        stream_stores: cfg
+            .stream_stores
+            .unwrap_or(cfg.n.iter().product::<usize>() * Q * 4 * 2 > STREAM_STORES_ABOVE_BYTES),
     }
 }
 
@@ -227,13 +235,13 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                     let start = links.len() as u32;
                     if !is_solid {
                         for k in 1..Q {
-                            let Some(s) = source(p, L::C[k]) else { continue };
+                            let Some(s) = source(p, L::C_REF[k]) else { continue };
                             if !solid[node(s)] {
                                 continue;
                             }
                             // The unwrapped segment from the node towards its solid source.
                             let a = pos(p);
-                            let b = [0, 1, 2].map(|d| a[d] - L::C[k][d] as f64 * cfg.grid.dx);
+                            let b = [0, 1, 2].map(|d| a[d] - L::C_REF[k][d] as f64 * cfg.grid.dx);
                             let body = inside(pos(s)).unwrap_or(0);
                             links.push(Link {
                                 node: node(p) as u32,
@@ -260,8 +268,8 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         Ok(Lbm3 {
             relax: Relax::new(cfg.tau, cfg.smagorinsky),
             velocity_scale: 1.0,
-            f: AlignedVec::zeros(cells * Q),
-            f_next: AlignedVec::zeros(cells * Q),
+            f: AlignedVec::zeros_padded(cells * Q, PAD),
+            f_next: AlignedVec::zeros_padded(cells * Q, PAD),
             plan: Plan {
                 solid,
                 specials,
@@ -313,7 +321,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                     };
                     let geq = equilibrium::<Q, L>((rho - 1.0) as f32, u.map(|v| v as f32));
                     for (i, g) in geq.iter().enumerate() {
-                        self.f[((z * ny + y) * Q + i) * nx + x] = *g;
+                        self.f[index::<Q>(self.cfg.n, [x, y, z], i)] = *g;
                     }
                 }
             }
@@ -322,8 +330,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
 
     /// Populations of node `p` (shifted, `f_i - w_i`).
     fn populations(&self, p: [usize; 3]) -> [f32; Q] {
-        let [nx, ny, _] = self.cfg.n;
-        std::array::from_fn(|i| self.f[((p[2] * ny + p[1]) * Q + i) * nx + p[0]])
+        std::array::from_fn(|i| self.f[index::<Q>(self.cfg.n, p, i)])
     }
 
     /// Density and velocity of node `p` (`u = (j + F/2) / rho` with a body force).
@@ -372,11 +379,11 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         for l in c.links {
             let n = l.node as usize;
             let p = [n % nx, (n / nx) % ny, n / (nx * ny)];
-            let i = L::OPP[l.k as usize];
+            let i = L::OPP_REF[l.k as usize];
             let g = src[c.idx::<Q>(p, i)] as f64 + bouzidi::<Q, L>(c, src, p, l) as f64;
             let f = &mut per_segment[l.body as usize * segments + p[2] * segments / nz];
             for a in 0..3 {
-                f[a] += L::C[i][a] as f64 * g;
+                f[a] += L::C_REF[i][a] as f64 * g;
             }
         }
         for (b, total) in per_body.iter_mut().enumerate() {
@@ -391,15 +398,14 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
 
     /// Advances one time step. Allocates nothing.
     pub fn step(&mut self) -> Result<(), LbmError> {
-        let kernel = row_fn::<Q, L>(self.cfg.collision, self.cfg.body_force != [0.0; 3], self.cfg.smagorinsky > 0.0);
-        let ctx = ctx(&self.cfg, &self.plan, self.relax, self.velocity_scale);
-        let src = &self.f;
-        let row_len = Q * self.cfg.n[0];
+        let kernel = plane_fn::<Q, L>(self.cfg.collision, self.cfg.body_force != [0.0; 3], self.cfg.smagorinsky > 0.0);
+        let ctx = ctx::<Q>(&self.cfg, &self.plan, self.relax, self.velocity_scale);
+        let (src, src_ext) = (&self.f[..], self.f.padded());
+        let plane_len = Q * self.cfg.n[0] * self.cfg.n[1];
         self.f_next
-            .par_chunks_mut(row_len)
+            .par_chunks_mut(plane_len)
             .enumerate()
-            .with_min_len(4)
-            .for_each(|(r, out)| kernel(&ctx, src, r, out));
+            .for_each(|(z, out)| kernel(&ctx, src, src_ext, z, out));
         Self::link_forces(&ctx, src, self.cfg.segments, &mut self.segment_forces, &mut self.body_forces);
         std::mem::swap(&mut self.f, &mut self.f_next);
         self.finish_step()
@@ -411,7 +417,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     pub fn step_reference(&mut self) -> Result<(), LbmError> {
         let forced = self.cfg.body_force != [0.0; 3];
         let les = self.cfg.smagorinsky > 0.0;
-        let ctx = ctx(&self.cfg, &self.plan, self.relax, self.velocity_scale);
+        let ctx = ctx::<Q>(&self.cfg, &self.plan, self.relax, self.velocity_scale);
         let [nx, ny, nz] = self.cfg.n;
         let mut next = vec![0.0f32; self.f.len()];
         let mut link = 0;
@@ -520,7 +526,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         for l in self.plan.links.iter_mut().filter(|l| l.body as usize == b) {
             let n = l.node as usize;
             let p = self.cfg.grid.position([n % nx, (n / nx) % ny, n / (nx * ny)]);
-            let c = L::C[l.k as usize];
+            let c = L::C_REF[l.k as usize];
             let at = [0, 1, 2].map(|a| p[a] - l.q as f64 * c[a] as f64 * dx);
             l.uw = u(at).map(|v| v as f32);
         }

@@ -1,0 +1,350 @@
+//! The third dimension of a flow: its span along z and how it is cut into segments, and the 3D
+//! solver a set-up with a span builds ([`LbmFlow3`]).
+//!
+//! A 2D body (circle, square, aerofoil, each pinball cylinder) is extruded along the whole span;
+//! spheres and cubes are bodies of their own. The box's x and y faces are the set-up's
+//! `boundaries` (west, east, south, north); the two z faces are the span's `boundary`.
+
+use serde::{Deserialize, Serialize};
+
+use hgym_solvers::geometry::{Cuboid, Extruded, Solid, Sphere};
+use hgym_solvers::lbm::d3::{D3Config, D3q19, D3q27, Face, Faces, Grid3, Lattice3, Lbm3};
+use hgym_solvers::lbm::LbmError;
+
+use super::{BoundaryKind, FlowError, FlowPlan, FlowSetup, GeometrySpec};
+
+/// The 3D velocity set of a flow.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum Lattice3Name {
+    #[default]
+    D3q19,
+    D3q27,
+}
+
+impl Lattice3Name {
+    /// Bytes of populations per node: Q f32 values in two copies.
+    pub fn bytes_per_node(self) -> usize {
+        match self {
+            Lattice3Name::D3q19 => D3q19::BYTES_PER_CELL_F32,
+            Lattice3Name::D3q27 => D3q27::BYTES_PER_CELL_F32,
+        }
+    }
+}
+
+/// The span of a 3D flow.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SpanSpec {
+    /// `[z0, z1]` in reference lengths; `z1 - z0` must be a whole number of cells at every level.
+    #[serde(deserialize_with = "super::pair")]
+    pub z: [f64; 2],
+    /// The two z faces: periodic (an infinite span), free-slip or wall.
+    #[serde(default = "periodic")]
+    pub boundary: BoundaryKind,
+    /// Equal spanwise segments: forces (and the actuators of environments) per segment.
+    #[serde(default = "one")]
+    pub segments: usize,
+    #[serde(default)]
+    pub lattice: Lattice3Name,
+}
+
+fn periodic() -> BoundaryKind {
+    BoundaryKind::Periodic
+}
+
+fn one() -> usize {
+    1
+}
+
+impl SpanSpec {
+    pub fn length(&self) -> f64 {
+        self.z[1] - self.z[0]
+    }
+
+    /// Finite `z0 < z1`, a z boundary the span can have, at least one segment.
+    pub(crate) fn check(&self) -> Result<(), FlowError> {
+        let bad = |field, message: String| Err(FlowError::Invalid { field, message });
+        if !(self.z.iter().all(|v| v.is_finite()) && self.z[0] < self.z[1]) {
+            return bad("span.z", format!("must be a finite [z0, z1] with z0 < z1, got {:?}", self.z));
+        }
+        if matches!(self.boundary, BoundaryKind::Inlet | BoundaryKind::Outlet) {
+            return bad(
+                "span.boundary",
+                format!("{:?} is not a spanwise face; use periodic, free-slip or wall", self.boundary),
+            );
+        }
+        if self.segments == 0 {
+            return bad("span.segments", "must be at least 1".into());
+        }
+        Ok(())
+    }
+
+    /// Nodes along z at `cells_per_length`; refused unless the span is a whole number of cells
+    /// that the segments divide.
+    pub(crate) fn nodes(&self, cells_per_length: f64, level: &str) -> Result<usize, FlowError> {
+        let cells = self.length() * cells_per_length;
+        let nz = cells.round();
+        if (cells - nz).abs() > 1e-6 || nz < 1.0 {
+            return Err(FlowError::Invalid {
+                field: "span.z",
+                message: format!(
+                    "the span {} L is {cells:.3} cells at the {level} level ({cells_per_length} cells per L); it must be a \
+                     whole number of cells: make it a multiple of {:.4} L",
+                    self.length(),
+                    1.0 / cells_per_length
+                ),
+            });
+        }
+        let nz = nz as usize;
+        if !nz.is_multiple_of(self.segments) {
+            return Err(FlowError::Invalid {
+                field: "span.segments",
+                message: format!(
+                    "{} segments do not divide the {nz} cells of the span at the {level} level; use a divisor of {nz}",
+                    self.segments
+                ),
+            });
+        }
+        Ok(nz)
+    }
+}
+
+impl GeometrySpec {
+    /// The body as a 3D solid: spheres and cubes as they are, 2D sections extruded along z.
+    pub fn solid(&self) -> Box<dyn Solid> {
+        match self {
+            GeometrySpec::Sphere { center, diameter } => Box::new(Sphere {
+                center: *center,
+                radius: 0.5 * diameter,
+            }),
+            GeometrySpec::Cube { center, side } => Box::new(Cuboid {
+                center: *center,
+                size: [*side; 3],
+            }),
+            other => Box::new(Extruded(SharedShape(other.shape()))),
+        }
+    }
+}
+
+/// A 2D shape behind an `Arc`, as a [`hgym_solvers::geometry::Shape`] of its own.
+#[derive(Debug)]
+struct SharedShape(std::sync::Arc<dyn hgym_solvers::geometry::Shape>);
+
+impl hgym_solvers::geometry::Shape for SharedShape {
+    fn sdf(&self, p: [f64; 2]) -> f64 {
+        self.0.sdf(p)
+    }
+    fn bounding_box(&self) -> [f64; 4] {
+        self.0.bounding_box()
+    }
+    fn wall_fraction(&self, a: [f64; 2], b: [f64; 2]) -> f64 {
+        self.0.wall_fraction(a, b)
+    }
+}
+
+/// A 3D flow's solver, for either velocity set.
+pub enum LbmFlow3 {
+    D3q19(Box<Lbm3<19, D3q19>>),
+    D3q27(Box<Lbm3<27, D3q27>>),
+}
+
+/// Calls the same method on whichever solver `self` holds.
+macro_rules! each {
+    ($self:expr, $s:ident => $body:expr) => {
+        match $self {
+            LbmFlow3::D3q19($s) => $body,
+            LbmFlow3::D3q27($s) => $body,
+        }
+    };
+}
+
+impl LbmFlow3 {
+    pub fn step(&mut self) -> Result<(), LbmError> {
+        each!(self, s => s.step())
+    }
+
+    /// Force on each body in the level's lattice units.
+    pub fn body_forces(&self) -> &[[f64; 3]] {
+        each!(self, s => s.body_forces())
+    }
+
+    /// Force on each (body, segment), `[b * segments + s]`.
+    pub fn segment_forces(&self) -> &[[f64; 3]] {
+        each!(self, s => s.segment_forces())
+    }
+
+    pub fn set_boundary_velocity_scale(&mut self, scale: f64) {
+        each!(self, s => s.set_velocity_scale(scale))
+    }
+
+    /// Wall velocity of body `b` at each wall point (lattice velocities).
+    pub fn set_wall_velocity(&mut self, b: usize, u: impl Fn([f64; 3]) -> [f64; 3]) {
+        each!(self, s => s.set_wall_velocity(b, u))
+    }
+
+    /// Every fluid node at the equilibrium of `field(x, y, z) = (rho, u)` (physical positions,
+    /// lattice velocities).
+    pub fn init_with(&mut self, field: impl Fn([f64; 3]) -> (f64, [f64; 3])) {
+        each!(self, s => {
+            let grid = s.config().grid;
+            s.set_equilibrium(|x, y, z| field(grid.position([x, y, z])))
+        })
+    }
+
+    /// Density and lattice velocity at a physical point (trilinear).
+    pub fn probe(&self, x: [f64; 3]) -> Result<(f64, [f64; 3]), LbmError> {
+        each!(self, s => s.probe(x))
+    }
+
+    pub fn time(&self) -> u64 {
+        each!(self, s => s.time())
+    }
+
+    pub fn n(&self) -> [usize; 3] {
+        each!(self, s => s.config().n)
+    }
+
+    pub fn grid(&self) -> Grid3 {
+        each!(self, s => s.config().grid)
+    }
+
+    pub fn is_solid(&self, p: [usize; 3]) -> bool {
+        each!(self, s => s.is_solid(p))
+    }
+
+    /// Density and lattice velocity of node `p`.
+    pub fn rho_u(&self, p: [usize; 3]) -> (f64, [f64; 3]) {
+        each!(self, s => s.rho_u(p))
+    }
+}
+
+impl FlowSetup {
+    /// Builds the 3D solver at `plan` (a set-up with a span): faces from the boundaries and the
+    /// span, the inlet's uniform velocity, collision, subgrid viscosity, the bodies as solids.
+    /// The fluid starts at rest; callers set their initial state.
+    pub fn build3(&self, plan: &FlowPlan) -> Result<LbmFlow3, FlowError> {
+        let Some(span) = &self.span else {
+            return Err(FlowError::Invalid {
+                field: "span",
+                message: "a 2D flow has no span; build it with `build`".into(),
+            });
+        };
+        let u = self.lattice_velocity as f32;
+        let face = |k: BoundaryKind| match k {
+            BoundaryKind::Inlet => Face::Velocity([u, 0.0, 0.0]),
+            BoundaryKind::Outlet => Face::Outlet,
+            BoundaryKind::Periodic => Face::Periodic,
+            BoundaryKind::Wall => Face::Wall,
+            BoundaryKind::FreeSlip => Face::FreeSlip,
+        };
+        let b = &self.boundaries;
+        let d = &self.domain;
+        let nz = plan.nz.ok_or_else(|| FlowError::Invalid {
+            field: "span",
+            message: "the plan is a 2D one; make it from this set-up with `plan`".into(),
+        })?;
+        let mut cfg = D3Config::new([plan.nx, plan.ny, nz], plan.tau);
+        cfg.faces = Faces([
+            face(b.west),
+            face(b.east),
+            face(b.south),
+            face(b.north),
+            face(span.boundary),
+            face(span.boundary),
+        ]);
+        cfg.grid = Grid3 {
+            origin: [d.x[0] + 0.5 * plan.dx, d.y[0] + 0.5 * plan.dx, span.z[0] + 0.5 * plan.dx],
+            dx: plan.dx,
+        };
+        cfg.segments = span.segments;
+        cfg.collision = plan.collision;
+        cfg.smagorinsky = self.smagorinsky;
+        cfg.check_interval = super::build::CHECK_INTERVAL;
+        let solids: Vec<Box<dyn Solid>> = self.bodies.iter().map(GeometrySpec::solid).collect();
+        let bodies: Vec<&dyn Solid> = solids.iter().map(|b| b.as_ref()).collect();
+        let built = match span.lattice {
+            Lattice3Name::D3q19 => Lbm3::<19, D3q19>::new(cfg, &bodies).map(|s| LbmFlow3::D3q19(Box::new(s))),
+            Lattice3Name::D3q27 => Lbm3::<27, D3q27>::new(cfg, &bodies).map(|s| LbmFlow3::D3q27(Box::new(s))),
+        };
+        built.map_err(|e| match e {
+            LbmError::Config { field, message } => FlowError::Invalid { field, message },
+            other => FlowError::Solver(other),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flow::Level;
+
+    /// A sphere of diameter 1 in a 12 x 8 x 8 box: inlet, outlets on the other faces.
+    fn sphere(extra: &str) -> String {
+        format!(
+            r#"
+bodies = [{{ shape = "sphere", center = [4.0, 4.0, 4.0], diameter = 1.0 }}]
+domain = {{ x = [0.0, 12.0], y = [0.0, 8.0] }}
+boundaries = {{ west = "inlet", east = "outlet", south = "outlet", north = "outlet" }}
+inlet = {{}}
+reynolds = 100.0
+lattice_velocity = 0.05
+collision = "regularized"
+smagorinsky = 0.0
+resolution = {{ coarse = 4, default = 8, fine = 16 }}
+sponges = []
+{extra}
+"#
+        )
+    }
+
+    fn setup(text: &str) -> FlowSetup {
+        toml::from_str(text).unwrap()
+    }
+
+    #[test]
+    fn a_span_gives_the_third_axis_and_the_3d_solver() {
+        let s = setup(&sphere("span = { z = [0.0, 8.0], boundary = \"free-slip\", segments = 2 }"));
+        s.check().unwrap();
+        let plan = s.plan(Level::Coarse).unwrap();
+        assert_eq!((plan.nx, plan.ny, plan.nz), (48, 32, Some(32)));
+        assert_eq!(plan.bytes_per_node, 152);
+        let mut flow = s.build3(&plan).unwrap();
+        assert_eq!(flow.n(), [48, 32, 32]);
+        // The node nearest the sphere's centre is solid, a corner is not.
+        assert!(flow.is_solid([16, 16, 16]) && !flow.is_solid([0, 0, 0]));
+        flow.init_with(|_| (1.0, [0.05, 0.0, 0.0]));
+        for _ in 0..5 {
+            flow.step().unwrap();
+        }
+        let drag = flow.body_forces()[0][0];
+        let segments = flow.segment_forces();
+        assert!(drag > 0.0, "{drag}");
+        assert!((segments[0][0] + segments[1][0] - drag).abs() < 1e-12);
+        assert!((s.reference_area() - std::f64::consts::FRAC_PI_4).abs() < 1e-15);
+        // The 2D builder refuses it.
+        assert!(matches!(s.build(&plan), Err(FlowError::Invalid { field: "span", .. })));
+    }
+
+    #[test]
+    fn refuses_what_a_span_cannot_hold() {
+        let field = |extra: &str| match setup(&sphere(extra))
+            .check()
+            .and_then(|_| setup(&sphere(extra)).plan(Level::Fine).map(|_| ()))
+        {
+            Err(FlowError::Invalid { field, message }) => format!("{field}: {message}"),
+            other => format!("{other:?}"),
+        };
+        assert!(field("").starts_with("bodies: a sphere needs a 3D flow"), "{}", field(""));
+        // 8.1 L is 32.4 cells at the coarse level.
+        assert!(
+            field("span = { z = [0.0, 8.1] }").starts_with("span.z:"),
+            "{}",
+            field("span = { z = [0.0, 8.1] }")
+        );
+        assert!(field("span = { z = [0.0, 8.0], segments = 3 }").starts_with("span.segments:"));
+        // A sphere that crosses the periodic z faces.
+        assert!(field("span = { z = [3.25, 7.25] }").starts_with("bodies: body 1 spans z"));
+        assert!(field("span = { z = [0.0, 8.0], boundary = \"inlet\" }").starts_with("span.boundary:"));
+    }
+}
