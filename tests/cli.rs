@@ -809,7 +809,10 @@ fn a_3d_case_runs_through_the_span_path() {
     let o = run_coarse(&case, &out, false);
     let (stdout, stderr) = text(&o);
     assert!(matches!(o.status.code(), Some(0 | 1)), "stdout: {stdout}\nstderr: {stderr}");
-    assert!(stderr.contains("40 x 24 x 24 nodes"), "the grid and its memory come first: {stderr}");
+    assert!(
+        stderr.contains("40 x 24 x 24 nodes"),
+        "the grid and its memory come first: {stderr}"
+    );
     assert!(stdout.contains("40 x 24 x 24 cells"), "{stdout}");
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("sphere_re100.json")).unwrap()).unwrap();
     schema_check(&report);

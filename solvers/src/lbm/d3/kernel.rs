@@ -11,20 +11,11 @@
 //! values.
 
 use super::super::collision::Relax;
+pub(crate) use super::super::kernel::Special;
 use super::super::kernel::{nt_rows_possible, store_fence, stream_aligned};
 use super::collision::{collide, collide_chunk, CHUNK};
 use super::lattice::Lattice3;
 use super::sides::{face_value, Faces};
-
-/// A node that needs the general path.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Special {
-    pub x: u32,
-    pub solid: bool,
-    /// Range of this node's links in the link list.
-    pub link_start: u32,
-    pub link_end: u32,
-}
 
 /// A link from fluid node `node` whose streaming source in direction `k` (the node `node - c_k`)
 /// is inside a body; the wall is at fraction `q` of the way towards it.
