@@ -167,12 +167,15 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
             a.core_hours
         );
     }
-    println!(
-        "  fine-tuning saves {:.0} % of the episodes and {:.0} % of the core-hours to the threshold\n  results: {}",
-        cmp.episode_saving_pct,
-        cmp.cost_saving_pct,
-        root.display()
-    );
+    if cmp.episode_saving_pct.is_finite() {
+        println!(
+            "  fine-tuning saves {:.0} % of the episodes and {:.0} % of the core-hours to the threshold",
+            cmp.episode_saving_pct, cmp.cost_saving_pct
+        );
+    } else {
+        println!("  no saving to report: the fine-tuning or the from-scratch arm never stays above the threshold");
+    }
+    println!("  results: {}", root.display());
     Ok(Outcome::Ok)
 }
 

@@ -3,8 +3,10 @@
 //! Performance is measured as in `hgym compare` ([`crate::train::compare`]): the threshold is
 //! `R_0 + fraction (R_scratch - R_0)` with `R_0` the uncontrolled return on the periodic
 //! evaluation episodes and `R_scratch` the from-scratch arm's final periodic evaluation (mean over
-//! seeds); a run reaches it at its first evaluation at or above it. A fine-tuning run evaluates
-//! its starting policy at 0 samples, so a source that is already good enough reaches it at 0.
+//! seeds). A run reaches it at the first evaluation from which it stays at or above it (every
+//! later evaluation too): a fine-tuning run evaluates its starting policy at 0 samples, and a
+//! source that is good enough there but is unlearned in the first updates must not count as
+//! having reached it at 0. A run whose final evaluation is below never reaches it.
 //! Final drag reductions and returns are each run's final evaluation (`metrics.json`). Cost is
 //! core-hours: wall time times threads; the cost to threshold scales a run's core-hours by the
 //! fraction of its samples spent before reaching the threshold.
@@ -62,6 +64,13 @@ pub struct TransferComparison {
     pub episode_saving_pct: f64,
     /// `100 (1 - core-hours(finetune) / core-hours(scratch))` to the threshold.
     pub cost_saving_pct: f64,
+}
+
+/// Samples at the first evaluation from which every evaluation is at or above `threshold`.
+fn stays_above(rows: &[CurveRow], threshold: f64) -> Option<u64> {
+    let evals: Vec<&CurveRow> = rows.iter().filter(|r| r.eval_return.is_finite()).collect();
+    let from = evals.iter().rposition(|r| r.eval_return < threshold).map_or(0, |k| k + 1);
+    evals.get(from).map(|r| r.samples)
 }
 
 fn read(path: &Path) -> Result<String, CompareError> {
@@ -122,9 +131,7 @@ pub fn analyse(p: &Protocol, root: &Path, r0: f64, episode_actions: usize) -> Re
         run.samples_to_threshold = if run.arm == "zeroshot" {
             (run.final_return >= threshold).then_some(0)
         } else {
-            rows.iter()
-                .find(|r| r.eval_return.is_finite() && r.eval_return >= threshold)
-                .map(|r| r.samples)
+            stays_above(rows, threshold)
         };
     }
     let arms: Vec<ArmSummary> = super::protocol::ARMS
@@ -196,12 +203,38 @@ fn plot(p: &Protocol, cmp: &TransferComparison, curves: &[(String, Vec<CurveRow>
         (format!("threshold ({:.0} % of scratch's gain)", 100.0 * p.fraction), cmp.threshold),
         ("uncontrolled".to_string(), cmp.uncontrolled_return),
     ];
-    let title = format!(
-        "{} -> {} ({}): fine-tuning saves {:.0} % of episodes",
-        p.source,
-        p.target,
-        p.level.name(),
-        cmp.episode_saving_pct
-    );
+    let saving = if cmp.episode_saving_pct.is_finite() {
+        format!("fine-tuning saves {:.0} % of episodes", cmp.episode_saving_pct)
+    } else {
+        "no saving: an arm never stays above the threshold".to_string()
+    };
+    let title = format!("{} -> {} ({}): {saving}", p.source, p.target, p.level.name());
     Ok(curve_plot(path, &title, &groups, &hlines)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rows(evals: &[f64]) -> Vec<CurveRow> {
+        let text = std::iter::once(crate::train::curve::CSV_HEADER.to_string())
+            .chain(
+                evals
+                    .iter()
+                    .enumerate()
+                    .map(|(k, e)| format!("{k},{},0,0,NaN,NaN,{e},1,0", 1000 * k)),
+            )
+            .collect::<Vec<_>>()
+            .join("\n");
+        from_csv(&text).unwrap()
+    }
+
+    #[test]
+    fn a_run_reaches_the_threshold_where_it_stays_above_it() {
+        // Above at the start, below after: reached only from the third evaluation on.
+        assert_eq!(stays_above(&rows(&[-400.0, -480.0, -430.0, -420.0]), -440.0), Some(2000));
+        assert_eq!(stays_above(&rows(&[-400.0, -410.0]), -440.0), Some(0));
+        // Ends below: never.
+        assert_eq!(stays_above(&rows(&[-400.0, -430.0, -450.0]), -440.0), None);
+    }
 }
