@@ -423,6 +423,36 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
     Ok(Outcome::Ok)
 }
 
+/// What an `hgym eval` folder records besides its report: the flow, the policy and the seeds.
+pub struct EvalRun<'a> {
+    pub spec: &'a hgym::env::Spec,
+    pub level: Level,
+    pub policy: &'a str,
+    pub eval_seed: u64,
+    pub episodes: u64,
+}
+
+impl EvalRun<'_> {
+    /// Writes `dir/metrics.json` (the report) and `dir/manifest.json` (hgym/eval-manifest/v1).
+    pub fn write(&self, dir: &Path, report: &EvalReport, threads: usize, wall_s: f64) -> Result<()> {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        std::fs::write(dir.join("metrics.json"), serde_json::to_string_pretty(report)? + "\n")?;
+        let manifest = serde_json::json!({
+            "schema": "hgym/eval-manifest/v1",
+            "env_id": self.spec.id(),
+            "spec_hash": self.spec.hash(),
+            "spec": self.spec,
+            "level": self.level.name(),
+            "policy": self.policy,
+            "eval_seed": self.eval_seed,
+            "episodes": self.episodes,
+            "manifest": hgym::report::manifest::manifest(threads, wall_s),
+        });
+        std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&manifest)? + "\n")?;
+        Ok(())
+    }
+}
+
 pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
     let config = load_config(args.config.as_deref())?;
     let spec = resolve_spec(&args.env, &config).map_err(train_error)?;
@@ -525,21 +555,14 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
             .map(|c| if c.is_ascii_alphanumeric() || c == '.' { c } else { '_' })
             .collect();
         let dir = out.join(format!("{}-{}-{}", spec.id(), slug, args.level.name()));
-        std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        std::fs::write(dir.join("metrics.json"), serde_json::to_string_pretty(&report)? + "\n")?;
-        let m = hgym::report::manifest::manifest(threads, started.elapsed().as_secs_f64());
-        let manifest = serde_json::json!({
-            "schema": "hgym/eval-manifest/v1",
-            "env_id": spec.id(),
-            "spec_hash": spec.hash(),
-            "spec": spec,
-            "level": args.level.name(),
-            "policy": args.policy,
-            "eval_seed": args.eval_seed,
-            "episodes": args.episodes,
-            "manifest": m,
-        });
-        std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&manifest)? + "\n")?;
+        let run = EvalRun {
+            spec: &spec,
+            level: args.level,
+            policy: &args.policy,
+            eval_seed: args.eval_seed,
+            episodes: args.episodes,
+        };
+        run.write(&dir, &report, threads, started.elapsed().as_secs_f64())?;
         eprintln!("results: {}", dir.display());
     }
     if args.json {

@@ -10,7 +10,7 @@ use hgym::train::{resolve_spec, TrainOptions};
 use hgym::transfer::protocol::{Protocol, ARMS};
 use hgym::transfer::SourceRun;
 
-use crate::cli::train::{init_from, install_interrupt, protocol_run};
+use crate::cli::train::{init_from, install_interrupt, protocol_run, EvalRun};
 use crate::{thread_pool, Outcome, UsageError};
 
 #[derive(Args)]
@@ -210,19 +210,12 @@ fn zeroshot(p: &Protocol, src: &SourceRun, target: &hgym::env::Spec, dir: &std::
         None,
         &mut |_| {},
     )?;
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let manifest = serde_json::json!({
-        "schema": "hgym/eval-manifest/v1",
-        "env_id": target.id(),
-        "spec_hash": target.hash(),
-        "spec": target,
-        "level": p.level.name(),
-        "policy": src.dir.display().to_string(),
-        "eval_seed": p.config.train.eval_seed,
-        "episodes": n,
-        "manifest": hgym::report::manifest::manifest(threads, started.elapsed().as_secs_f64()),
-    });
-    std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&manifest)? + "\n")?;
-    std::fs::write(dir.join("metrics.json"), serde_json::to_string_pretty(&report)? + "\n")?;
-    Ok(())
+    let run = EvalRun {
+        spec: target,
+        level: p.level,
+        policy: &src.dir.display().to_string(),
+        eval_seed: p.config.train.eval_seed,
+        episodes: n,
+    };
+    run.write(dir, &report, threads, started.elapsed().as_secs_f64())
 }

@@ -122,24 +122,8 @@ impl GeometrySpec {
                 center: *center,
                 size: [*side; 3],
             }),
-            other => Box::new(Extruded(SharedShape(other.shape()))),
+            other => Box::new(Extruded(other.shape())),
         }
-    }
-}
-
-/// A 2D shape behind an `Arc`, as a [`hgym_solvers::geometry::Shape`] of its own.
-#[derive(Debug)]
-struct SharedShape(std::sync::Arc<dyn hgym_solvers::geometry::Shape>);
-
-impl hgym_solvers::geometry::Shape for SharedShape {
-    fn sdf(&self, p: [f64; 2]) -> f64 {
-        self.0.sdf(p)
-    }
-    fn bounding_box(&self) -> [f64; 4] {
-        self.0.bounding_box()
-    }
-    fn wall_fraction(&self, a: [f64; 2], b: [f64; 2]) -> f64 {
-        self.0.wall_fraction(a, b)
     }
 }
 

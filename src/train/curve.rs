@@ -21,6 +21,15 @@ pub struct CurveRow {
     pub eval_drag_reduction_pct: f64,
 }
 
+impl CurveRow {
+    /// Fills the evaluation columns from a periodic evaluation.
+    pub fn set_eval(&mut self, r: &super::eval::EvalReport) {
+        self.eval_return = r.ret.mean;
+        self.eval_c_d = r.mean_c_d.mean;
+        self.eval_drag_reduction_pct = r.drag_reduction_pct.mean;
+    }
+}
+
 pub const CSV_HEADER: &str = "round,samples,updates,wall_s,train_return,train_c_d,eval_return,eval_c_d,eval_drag_reduction_pct";
 
 pub fn to_csv(rows: &[CurveRow]) -> String {

@@ -196,6 +196,22 @@ pub fn train(
     let mut envs: Vec<Box<dyn FlowEnv>> = (0..n_envs).map(|_| make()).collect::<Result<_, _>>()?;
     let mut eval_env = make()?;
     let periodic_seeds = eval_seeds(config, config.train.eval_episodes.max(1));
+    let hash = spec.hash();
+    // The periodic evaluation of the learner's current policy: the curve's eval columns.
+    let periodic_eval = |env: &mut Box<dyn FlowEnv>, learner: &dyn Learner, reference: &[f64]| {
+        evaluate(
+            env,
+            &mut learner.policy(),
+            algo.name(),
+            spec.id(),
+            &hash,
+            opts.level.name(),
+            &periodic_seeds,
+            reference,
+            None,
+            &mut |_| {},
+        )
+    };
 
     let (mut learner, mut curve, reference, wall_before, resumed) = match resume {
         Some(ck) => {
@@ -212,29 +228,20 @@ pub fn train(
                     learner.init_critics(bytes, map, init.parts)?;
                 }
                 write_json(&opts.out.join(INIT_FILE), "the source run", &init.record)?;
-                let r = evaluate(
-                    &mut eval_env,
-                    &mut learner.policy(),
-                    algo.name(),
-                    spec.id(),
-                    &spec.hash(),
-                    opts.level.name(),
-                    &periodic_seeds,
-                    &reference,
-                    None,
-                    &mut |_| {},
-                )?;
-                curve.push(CurveRow {
+                let r = periodic_eval(&mut eval_env, learner.as_ref(), &reference)?;
+                let mut start = CurveRow {
                     round: 0,
                     samples: 0,
                     updates: 0,
                     wall_s: started.elapsed().as_secs_f64(),
                     train_return: f64::NAN,
                     train_c_d: f64::NAN,
-                    eval_return: r.ret.mean,
-                    eval_c_d: r.mean_c_d.mean,
-                    eval_drag_reduction_pct: r.drag_reduction_pct.mean,
-                });
+                    eval_return: f64::NAN,
+                    eval_c_d: f64::NAN,
+                    eval_drag_reduction_pct: f64::NAN,
+                };
+                start.set_eval(&r);
+                curve.push(start);
             }
             (learner, curve, reference, 0.0, 0)
         }
@@ -297,23 +304,8 @@ pub fn train(
         };
         let every = config.train.eval_every;
         if every > 0 && learner.rounds().is_multiple_of(every) {
-            let mut policy = learner.policy();
-            let hash = spec.hash();
-            let r = evaluate(
-                &mut eval_env,
-                &mut policy,
-                algo.name(),
-                spec.id(),
-                &hash,
-                opts.level.name(),
-                &periodic_seeds,
-                &reference,
-                None,
-                &mut |_| {},
-            )?;
-            row.eval_return = r.ret.mean;
-            row.eval_c_d = r.mean_c_d.mean;
-            row.eval_drag_reduction_pct = r.drag_reduction_pct.mean;
+            let r = periodic_eval(&mut eval_env, learner.as_ref(), &reference)?;
+            row.set_eval(&r);
             last_eval = Some((r.ret.mean, r.drag_reduction_pct.mean));
         }
         progress(&Progress {

@@ -64,6 +64,23 @@ pub trait Shape: Send + Sync + std::fmt::Debug {
     }
 }
 
+/// A shared shape is the shape it points to (bodies are held as `Arc<dyn Shape>` and extruded
+/// along a span as they are).
+impl<S: Shape + ?Sized> Shape for std::sync::Arc<S> {
+    fn sdf(&self, p: [f64; 2]) -> f64 {
+        (**self).sdf(p)
+    }
+    fn bounding_box(&self) -> [f64; 4] {
+        (**self).bounding_box()
+    }
+    fn wall_fraction(&self, a: [f64; 2], b: [f64; 2]) -> f64 {
+        (**self).wall_fraction(a, b)
+    }
+    fn normal(&self, p: [f64; 2]) -> [f64; 2] {
+        (**self).normal(p)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

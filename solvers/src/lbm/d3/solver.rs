@@ -7,7 +7,7 @@ use super::super::aligned::AlignedVec;
 use super::super::collision::{Collision, Relax, OP_BGK, OP_REG};
 use super::super::error::LbmError;
 use super::super::solver::STREAM_STORES_ABOVE_BYTES;
-use super::collision::{equilibrium, moments};
+use super::collision::{collide, equilibrium, moments};
 use super::kernel::{bouzidi, gather, index, plane, Ctx, Link, Special, PAD};
 use super::lattice::Lattice3;
 use super::sides::Faces;
@@ -80,16 +80,25 @@ impl D3Config {
 /// The plane kernel for one set of compile-time switches.
 type PlaneFn = fn(&Ctx, &[f32], &[f32], usize, &mut [f32]);
 
+/// `$f::<Q, L, OP, FORCED, LES>` for the operator, forcing and subgrid model chosen at run time
+/// (the subgrid model exists only for the regularised operator): the kernel and the oracle's
+/// collision are picked by the same table.
+macro_rules! monomorphised {
+    ($f:ident, $collision:expr, $forced:expr, $les:expr) => {
+        match ($collision, $forced, $les) {
+            (Collision::Bgk, false, _) => $f::<Q, L, OP_BGK, false, false>,
+            (Collision::Bgk, true, _) => $f::<Q, L, OP_BGK, true, false>,
+            (_, false, false) => $f::<Q, L, OP_REG, false, false>,
+            (_, true, false) => $f::<Q, L, OP_REG, true, false>,
+            (_, false, true) => $f::<Q, L, OP_REG, false, true>,
+            (_, true, true) => $f::<Q, L, OP_REG, true, true>,
+        }
+    };
+}
+
 /// Selects the kernel monomorphised for the operator, forcing and subgrid model.
 fn plane_fn<const Q: usize, L: Lattice3<Q>>(collision: Collision, forced: bool, les: bool) -> PlaneFn {
-    match (collision, forced, les) {
-        (Collision::Bgk, false, _) => plane::<Q, L, OP_BGK, false, false>,
-        (Collision::Bgk, true, _) => plane::<Q, L, OP_BGK, true, false>,
-        (_, false, false) => plane::<Q, L, OP_REG, false, false>,
-        (_, true, false) => plane::<Q, L, OP_REG, true, false>,
-        (_, false, true) => plane::<Q, L, OP_REG, false, true>,
-        (_, true, true) => plane::<Q, L, OP_REG, true, true>,
-    }
+    monomorphised!(plane, collision, forced, les)
 }
 
 /// A D3Q19 or D3Q27 lattice-Boltzmann solver on a periodic box with immersed bodies.
@@ -418,6 +427,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         let forced = self.cfg.body_force != [0.0; 3];
         let les = self.cfg.smagorinsky > 0.0;
         let ctx = ctx::<Q>(&self.cfg, &self.plan, self.relax, self.velocity_scale);
+        let collide_fn: fn(&mut [f32; Q], Relax, [f32; 3]) = monomorphised!(collide, self.cfg.collision, forced, les);
         let [nx, ny, nz] = self.cfg.n;
         let mut next = vec![0.0f32; self.f.len()];
         let mut link = 0;
@@ -433,7 +443,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                         link += 1;
                     }
                     let mut g = gather::<Q, L>(&ctx, &self.f, [x, y, z], &self.plan.links[start..link]);
-                    reference_collide::<Q, L>(&mut g, self.cfg.collision, forced, les, &ctx);
+                    collide_fn(&mut g, ctx.relax, ctx.force);
                     for (i, gi) in g.iter().enumerate() {
                         next[ctx.idx::<Q>([x, y, z], i)] = *gi;
                     }
@@ -595,19 +605,5 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     #[doc(hidden)]
     pub fn poison_scratch(&mut self) {
         self.f_next.iter_mut().for_each(|v| *v = f32::NAN);
-    }
-}
-
-/// The collision the oracle runs, chosen at run time (the fast kernel has it at compile time).
-fn reference_collide<const Q: usize, L: Lattice3<Q>>(g: &mut [f32; Q], collision: Collision, forced: bool, les: bool, c: &Ctx) {
-    use super::collision::collide;
-    let (r, f) = (c.relax, c.force);
-    match (collision, forced, les) {
-        (Collision::Bgk, false, _) => collide::<Q, L, OP_BGK, false, false>(g, r, f),
-        (Collision::Bgk, true, _) => collide::<Q, L, OP_BGK, true, false>(g, r, f),
-        (_, false, false) => collide::<Q, L, OP_REG, false, false>(g, r, f),
-        (_, true, false) => collide::<Q, L, OP_REG, true, false>(g, r, f),
-        (_, false, true) => collide::<Q, L, OP_REG, false, true>(g, r, f),
-        (_, true, true) => collide::<Q, L, OP_REG, true, true>(g, r, f),
     }
 }
