@@ -37,6 +37,8 @@ done
 # The fuzz targets of hostile input (tests/fuzz.rs, and the Hub replies in tests/hub_push.rs):
 # 10^4 inputs each (make test runs 64, the Hub 512).
 step fuzz env PROPTEST_CASES=10000 cargo test --release --locked --test fuzz --test hub_push
+# Exact-solution tests too slow for make test (the channel's raw Orr-Sommerfeld rate on a fine grid).
+step exact-slow cargo test --release --locked -p hgym-solvers --test channel_exact -- --ignored
 step leaderboard "$HGYM" leaderboard
 total=$(( $(date +%s) - start ))
 {

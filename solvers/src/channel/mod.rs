@@ -1,0 +1,22 @@
+//! Incompressible wall-bounded DNS: the plane channel (periodic in x and z, walls in y; or a
+//! free-slip top for the open channel), second-order finite differences on a staggered grid
+//! stretched towards the walls, FFT + tridiagonal pressure solve, low-storage RK3 with a
+//! projection per stage (the method of CaNS, Costa 2018).
+//!
+//! - [`grid`]: the staggered grid and its wall closures;
+//! - [`operators`]: advection, diffusion, divergence and gradient, plane by plane;
+//! - [`poisson`]: the direct pressure solver;
+//! - [`solver`]: [`Channel`], time stepping, drive, transpiration and diagnostics.
+
+// Index loops over grid points read like the stencils they implement.
+#![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
+
+pub mod error;
+pub mod grid;
+pub mod operators;
+pub mod poisson;
+pub mod solver;
+
+pub use error::ChannelError;
+pub use grid::{Grid, Top};
+pub use solver::{viscous_dt_limit, Channel, ChannelConfig, Drive};
