@@ -25,6 +25,7 @@ step validate-cylinder "$HGYM" validate cylinder --level default
 step validate-pinball  "$HGYM" validate pinball --level default
 step validate-square   "$HGYM" validate square --level default
 step validate-kolmogorov "$HGYM" validate kolmogorov
+step validate-channel "$HGYM" validate channel --level default
 step bench-lbm        "$HGYM" bench lbm
 step bench-refine     "$HGYM" bench refine
 step bench-agents     "$HGYM" bench agents

@@ -81,6 +81,7 @@ fn list_shows_the_bundled_cases() {
     assert!(o.status.success());
     let (out, _) = text(&o);
     assert!(out.contains("cylinder_re100") && out.contains("cylinder_re200"));
+    assert!(out.contains("kolmogorov_re40") && out.contains("channel_retau180"), "{out}");
 }
 
 #[test]

@@ -11,6 +11,7 @@ fn schema_file(path: &Path, v: &serde_json::Value) -> Option<&'static str> {
     let by_field = match v.get("schema").and_then(|s| s.as_str()) {
         Some("hgym/validation/v1") => Some("validation.schema.json"),
         Some("hgym/kolmogorov-validation/v1") => Some("kolmogorov-validation.schema.json"),
+        Some("hgym/channel-validation/v1") => Some("channel-validation.schema.json"),
         Some("hgym/train/v1") => Some("train.schema.json"),
         Some("hgym/eval/v1") => Some("eval.schema.json"),
         Some("hgym/eval-manifest/v1") => Some("eval-manifest.schema.json"),

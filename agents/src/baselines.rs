@@ -1,6 +1,7 @@
 //! Classical controllers as policies, on the same footing as the learners: zero, constant,
 //! uniform random, open-loop sine, and proportional-derivative feedback on an observation
-//! component or on an info value (e.g. the lift coefficient, "opposition control").
+//! component or on an info value (e.g. the lift coefficient, "opposition control"), and local
+//! feedback of every actuator on its own observations (opposition control of wall turbulence).
 
 use serde::{Deserialize, Serialize};
 
@@ -39,6 +40,10 @@ pub enum Baseline {
         target: f64,
         signs: Vec<f64>,
     },
+    /// Actuator `i` fed back from its own observation: `a_i = clip(-gain obs[i stride + offset])`
+    /// (opposition control of wall turbulence, Choi, Moin & Kim 1994: the wall velocity opposes
+    /// the wall-normal velocity at the sensing plane; stride 2, offset 1 in the channel flows).
+    Local { stride: usize, offset: usize, gain: f64 },
 }
 
 /// A baseline with its running state.
@@ -80,6 +85,10 @@ impl Policy for BaselinePolicy {
                     keys.join(", ")
                 ))
             }
+            Baseline::Local { stride, offset, .. } if *offset >= *stride || !obs.len().is_multiple_of(*stride) => Err(format!(
+                "local feedback reads observation {offset} of each group of {stride}, but the observation has {} values",
+                obs.len()
+            )),
             _ => Ok(()),
         }
     }
@@ -117,6 +126,12 @@ impl Policy for BaselinePolicy {
                 let u = -(kp * e + kd * de);
                 for (j, a) in action.iter_mut().enumerate() {
                     *a = (u * signs.get(j).copied().unwrap_or(1.0)).clamp(-1.0, 1.0);
+                }
+            }
+            Baseline::Local { stride, offset, gain } => {
+                for (j, a) in action.iter_mut().enumerate() {
+                    let s = obs.get(j * stride + offset).copied().unwrap_or(0.0);
+                    *a = (-gain * s).clamp(-1.0, 1.0);
                 }
             }
         }

@@ -176,8 +176,9 @@ impl Env {
         Ok((obs_array(py, &r.obs), r.reward, r.terminated, r.truncated, info_dict(py, &r.info)?))
     }
 
-    /// The vorticity as an RGB image (rows from the top of the domain), float colour range
-    /// `+-vmax` (default: the 98th percentile of |vorticity|); bodies grey.
+    /// The vorticity (for a flow without one, its first snapshot field: the channels' wall shear
+    /// stress excess) as an RGB image (rows from the top of the domain), colour range `+-vmax`
+    /// (default: the 98th percentile of |field|); bodies grey.
     #[pyo3(signature = (vmax = None))]
     fn render_rgb<'py>(&self, py: Python<'py>, vmax: Option<f64>) -> PyResult<Bound<'py, PyArray3<u8>>> {
         let snap = self.env()?.snapshot();
@@ -185,8 +186,9 @@ impl Env {
             .fields
             .iter()
             .find(|(name, _)| name == "vorticity")
+            .or(snap.fields.first())
             .map(|(_, v)| v)
-            .ok_or_else(|| PyRuntimeError::new_err("this environment has no vorticity field"))?;
+            .ok_or_else(|| PyRuntimeError::new_err("this environment has no flow field to show"))?;
         let vmax = vmax.unwrap_or_else(|| hgym::report::plots::abs_quantile(w, 0.98));
         let rgb = hgym::report::plots::field_rgb(snap.nx, snap.ny, w, vmax);
         PyArray1::from_vec(py, rgb)

@@ -85,7 +85,8 @@ pub struct TrainArgs {
 #[derive(Args)]
 pub struct EvalArgs {
     /// A training result folder (its policy.json), or a baseline: zero, random, sine[=period],
-    /// constant=v, opposition[=gain] (a = -gain C_L), pd=SIGNAL,kp,kd (SIGNAL: obs:i or an info key).
+    /// constant=v, opposition[=gain] (a = -gain C_L), wall-opposition[=gain] (channel flows: each
+    /// actuator a = -gain v' at its sensing point), pd=SIGNAL,kp,kd (SIGNAL: obs:i or an info key).
     #[arg(long)]
     policy: String,
     /// Environment ID. A run folder trained on another flow is mapped onto it (zero-shot

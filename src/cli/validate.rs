@@ -82,14 +82,24 @@ pub fn run(args: ValidateArgs) -> Result<Outcome> {
         }
         return Ok(if r.pass { Outcome::Ok } else { Outcome::CheckFailed });
     }
+    if args.names == ["channel"] || args.names == ["channel_retau180"] {
+        return run_channel(&args);
+    }
     if args.list {
         for c in validate::bundled()? {
             println!("{:<10} {:<18} {}", c.case.case.family, c.case.case.name, c.case.case.description);
         }
+        // The cases with formats of their own (spectral and finite-difference solvers).
+        let k = hgym::fidelity::kolmogorov::case().context("the bundled case kolmogorov_re40.toml")?;
+        println!("{:<10} {:<18} {}", "kolmogorov", k.case, k.description);
+        let c = hgym::validate::channel::case().context("the bundled case channel_retau180.toml")?;
+        println!("{:<10} {:<18} {}", "channel", c.case, c.description);
         return Ok(Outcome::Ok);
     }
-    if args.names.len() > 1 && args.names.iter().any(|n| n == "kolmogorov") {
-        return Err(UsageError("run `hgym validate kolmogorov` on its own".into()).into());
+    for own in ["kolmogorov", "channel"] {
+        if args.names.len() > 1 && args.names.iter().any(|n| n == own) {
+            return Err(UsageError(format!("run `hgym validate {own}` on its own")).into());
+        }
     }
     let cases: Vec<LoadedCase> = match (args.names.is_empty(), args.cases.is_empty()) {
         (false, false) => return Err(UsageError("give either families or --case FILE, not both".into()).into()),
@@ -206,4 +216,54 @@ fn run_envs(args: &ValidateArgs) -> Result<Outcome> {
     }
     let all_pass = reports.iter().all(|r| r.status.is_ok());
     Ok(if all_pass { Outcome::Ok } else { Outcome::CheckFailed })
+}
+
+/// `hgym validate channel`: the turbulent channel at Re_tau 180 against the DNS databases.
+fn run_channel(args: &ValidateArgs) -> Result<Outcome> {
+    use hgym::validate::channel;
+    let (pool, _) = thread_pool(args.threads)?;
+    let case = channel::case().context("the bundled case benchmarks/validation/channel_retau180.toml")?;
+    let l = case.level(args.level).clone();
+    let cache = hgym::env::default_cache_dir();
+    if !args.json {
+        eprintln!(
+            "channel_retau180 ({}): {}x{}x{} cells on {:.2} x {:.0} x {:.2} h, dt {} h/U_b; spin-up {} (cached after the first run), average {} h/U_b",
+            args.level.name(), l.n[0], l.n[1], l.n[2], case.length[0], case.length[1], case.length[2], l.dt, l.spin_up, l.average
+        );
+    }
+    let mut pb: Option<Progress> = None;
+    let r = pool
+        .install(|| {
+            channel::validate(args.level, &args.out, cache.as_deref(), &mut |done, total| {
+                pb.get_or_insert_with(|| Progress::new(total, "channel Re_tau 180"))
+                    .set_position(done)
+            })
+        })
+        .map_err(|e| match e {
+            channel::ChannelValidationError::Unrunnable(_) => anyhow::Error::new(UsageError(e.to_string())),
+            e => anyhow::Error::new(e).context("channel validation"),
+        })?;
+    if let Some(pb) = pb {
+        pb.finish_and_clear();
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&r)?);
+    } else {
+        println!(
+            "channel_retau180 ({}, {}x{}x{}, {} samples over {} h/U_b; first cell y+ {:.2}):",
+            r.level, r.n[0], r.n[1], r.n[2], r.samples, r.average, r.first_cell_y_plus
+        );
+        for c in &r.checks {
+            println!(
+                "  {} {:<40} {:>10.5} (reference {:.5}, tolerance {})",
+                if c.pass { "pass" } else { "FAIL" },
+                c.name,
+                c.value,
+                c.reference,
+                c.tolerance
+            );
+        }
+        println!("  results: {}", args.out.join("channel_retau180.json").display());
+    }
+    Ok(if r.pass { Outcome::Ok } else { Outcome::CheckFailed })
 }

@@ -118,14 +118,7 @@ pub fn calibrate(
     let zero = vec![0.0; spec.act_dim()];
     let mut forces = [0.0f64; 2];
     for k in 0..actions {
-        let r = env.step(&zero)?;
-        if r.terminated {
-            return Err(EnvError::Backend(format!(
-                "{}: uncontrolled run diverged: {}",
-                spec.id,
-                r.info.text("reason").unwrap_or("?")
-            )));
-        }
+        let r = super::family::uncontrolled_step(&mut env, &spec.id, &zero)?;
         for (sum, key) in forces.iter_mut().zip(["C_D", "C_L"]) {
             *sum += super::info_value(&r.info, key)?;
         }

@@ -94,6 +94,23 @@ pub(crate) fn check_episode(control_interval: f64, episode_actions: usize, spin_
     Ok(())
 }
 
+/// One uncontrolled control interval of a calibration run; a diverged flow is an error naming
+/// the ID and the solver's reason.
+pub(crate) fn uncontrolled_step<E: hgym_agents::Env + ?Sized>(
+    env: &mut E,
+    id: &str,
+    zero: &[f64],
+) -> Result<hgym_agents::StepResult, EnvError> {
+    let r = env.step(zero)?;
+    if r.terminated {
+        return Err(EnvError::Backend(format!(
+            "{id}: uncontrolled run diverged: {}",
+            r.info.text("reason").unwrap_or("?")
+        )));
+    }
+    Ok(r)
+}
+
 /// Why a calibration did not record its statistics.
 #[derive(Debug, thiserror::Error)]
 pub enum CalibrateError {

@@ -613,14 +613,7 @@ pub fn calibrate(spec: &KolmogorovSpec, level: Level, actions: usize, progress: 
     let zero = vec![0.0; spec.act_dim()];
     let (mut u2, mut count, mut eps, mut tke) = (0.0, 0usize, vec![], 0.0);
     for k in 0..actions.max(1) {
-        let r = env.step(&zero)?;
-        if r.terminated {
-            return Err(EnvError::Backend(format!(
-                "{}: uncontrolled run diverged: {}",
-                spec.id,
-                r.info.text("reason").unwrap_or("?")
-            )));
-        }
+        let r = super::family::uncontrolled_step(&mut env, &spec.id, &zero)?;
         u2 += r.obs.iter().map(|v| v * v).sum::<f64>();
         count += r.obs.len();
         eps.push(info_value(&r.info, "dissipation")?);

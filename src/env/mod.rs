@@ -3,7 +3,8 @@
 //! - [`family`]: the trait a family implements, the spec and environment types everything else
 //!   sees ([`family::Spec`], [`family::FlowEnv`]);
 //! - [`registry`]: the list of families and the lookup; [`cylinder`], [`pinball`], [`square`],
-//!   [`cavity`], [`naca`], [`pipe`] (lattice Boltzmann), [`kolmogorov`] (spectral): one file each;
+//!   [`cavity`], [`naca`], [`pipe`] (lattice Boltzmann), [`kolmogorov`] (spectral), [`channel`]
+//!   (finite-difference channel DNS): one file each;
 //! - [`spec`]: the serialisable description of a lattice-Boltzmann environment (its hash keys
 //!   caches and results); [`lbm_env`]: its `Env` implementation;
 //! - [`actuation`]: jets, rotation, and the temporal smoothing of actions;
@@ -13,6 +14,7 @@
 pub mod actuation;
 pub mod calibrate;
 pub mod cavity;
+pub mod channel;
 pub mod cylinder;
 pub mod family;
 pub mod fields;

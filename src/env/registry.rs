@@ -2,7 +2,7 @@
 
 use super::family::{Family, Spec};
 use super::spec::EnvSpec;
-use super::{calibrate, cavity, cylinder, kolmogorov, naca, pinball, pipe, square, EnvInputError};
+use super::{calibrate, cavity, channel, cylinder, kolmogorov, naca, pinball, pipe, square, EnvInputError};
 
 /// The families, in listing order. A new family is one file implementing [`Family`] and one
 /// line here.
@@ -14,6 +14,7 @@ pub const FAMILIES: &[&dyn Family] = &[
     &naca::Naca,
     &pipe::Pipe,
     &kolmogorov::KolmogorovFlows,
+    &channel::Channels,
 ];
 
 /// All registered specs, in a fixed order, with their committed statistics.

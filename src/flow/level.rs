@@ -39,6 +39,26 @@ impl std::str::FromStr for Level {
     }
 }
 
+/// One value per level (a grid, a time step, a window): `[coarse]`, `[default]`, `[fine]`
+/// tables or keys in a file.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PerLevel<T> {
+    pub coarse: T,
+    pub default: T,
+    pub fine: T,
+}
+
+impl<T> PerLevel<T> {
+    pub fn at(&self, level: Level) -> &T {
+        match level {
+            Level::Coarse => &self.coarse,
+            Level::Default => &self.default,
+            Level::Fine => &self.fine,
+        }
+    }
+}
+
 /// Cells per reference length at each level.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]

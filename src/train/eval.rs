@@ -105,8 +105,9 @@ pub fn evaluate<E: Env + crate::env::fields::FlowFields + ?Sized>(
 
 /// A policy named on the command line: a trained-run folder (its `policy.json`), or a
 /// classical baseline: `zero`, `random`, `sine[=period]`, `constant=v`, `opposition[=gain]`
-/// (proportional feedback against the lift, `a = -gain C_L`), `pd=SIGNAL,kp,kd` with SIGNAL
-/// `obs:i` or an info key such as `C_L`.
+/// (proportional feedback against the lift, `a = -gain C_L`), `wall-opposition[=gain]` (each
+/// wall actuator against the wall-normal velocity at its sensing point, the channel flows'
+/// opposition control), `pd=SIGNAL,kp,kd` with SIGNAL `obs:i` or an info key such as `C_L`.
 pub enum NamedPolicy {
     Trained(Box<ActorPolicy>),
     Baseline(Baseline),
@@ -158,6 +159,11 @@ pub fn parse_policy(text: &str) -> Result<NamedPolicy, PolicyError> {
             target: 0.0,
             signs: vec![],
         },
+        ("wall-opposition", g) => Baseline::Local {
+            stride: 2,
+            offset: 1,
+            gain: g.map(num).transpose()?.unwrap_or(1.0),
+        },
         ("pd", Some(spec)) => {
             let parts: Vec<&str> = spec.split(',').collect();
             if parts.len() != 3 {
@@ -186,7 +192,7 @@ pub fn parse_policy(text: &str) -> Result<NamedPolicy, PolicyError> {
             if !file.exists() {
                 return Err(PolicyError::Invalid(format!(
                     "--policy {text}: neither a result folder with policy.json nor a baseline \
-                     (zero, random, sine[=period], constant=v, opposition[=gain], pd=SIGNAL,kp,kd)"
+                     (zero, random, sine[=period], constant=v, opposition[=gain], wall-opposition[=gain], pd=SIGNAL,kp,kd)"
                 )));
             }
             let body = std::fs::read_to_string(&file).map_err(|source| PolicyError::Read {

@@ -10,6 +10,7 @@
 
 pub mod analysis;
 pub mod case;
+pub mod channel;
 pub mod report;
 pub mod run;
 pub mod series;

@@ -6,7 +6,8 @@
 //! - [`grid`]: the staggered grid and its wall closures;
 //! - [`operators`]: advection, diffusion, divergence and gradient, plane by plane;
 //! - [`poisson`]: the direct pressure solver;
-//! - [`solver`]: [`Channel`], time stepping, drive, transpiration and diagnostics.
+//! - [`solver`]: [`Channel`], time stepping, drive, transpiration and diagnostics;
+//! - [`stats`]: plane-averaged means and second moments.
 
 // Index loops over grid points read like the stencils they implement.
 #![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
@@ -16,7 +17,9 @@ pub mod grid;
 pub mod operators;
 pub mod poisson;
 pub mod solver;
+pub mod stats;
 
 pub use error::ChannelError;
 pub use grid::{Grid, Top};
 pub use solver::{viscous_dt_limit, Channel, ChannelConfig, Drive};
+pub use stats::{PlaneSums, Profiles};
