@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 
 use hgym_agents::{checked_action, BoxSpace, DifferentiableEnv, Env, EnvError, Info, StepResult};
-use hgym_solvers::channel::{viscous_dt_limit, Channel, ChannelConfig, Drive, Grid, Top};
+use hgym_solvers::channel::{viscous_dt_limit, Channel, ChannelConfig, ChannelState as State, Drive, Grid, Top};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
@@ -370,15 +370,6 @@ impl FamilySpec for ChannelSpec {
     }
 }
 
-/// A developed velocity field.
-#[derive(Serialize, Deserialize)]
-struct State {
-    n: [usize; 3],
-    u: Vec<f64>,
-    v: Vec<f64>,
-    w: Vec<f64>,
-}
-
 /// Developed states shared by every environment of the process, keyed by physics hash and level.
 fn developed() -> &'static Mutex<HashMap<String, Arc<State>>> {
     static CACHE: OnceLock<Mutex<HashMap<String, Arc<State>>>> = OnceLock::new();
@@ -494,12 +485,7 @@ impl ChannelEnv {
                 let solver = &mut self.solver;
                 super::spin_up::run_reported(&id, steps, |k| (0..k).try_for_each(|_| solver.step()))
                     .map_err(|e| EnvError::Backend(format!("{}: spin-up failed: {e}", self.spec.id)))?;
-                let s = State {
-                    n,
-                    u: self.solver.u().to_vec(),
-                    v: self.solver.v().to_vec(),
-                    w: self.solver.w().to_vec(),
-                };
+                let s = self.solver.state();
                 if let Some(p) = self.cache_file() {
                     // A cache that cannot be written only costs the next process its spin-up.
                     if let Some(dir) = p.parent() {
@@ -598,7 +584,7 @@ impl Env for ChannelEnv {
         bottom.fill(0.0);
         top.fill(0.0);
         self.solver.set_transpiration(bottom, top).map_err(backend)?;
-        self.solver.set_velocity(&state.u, &state.v, &state.w).map_err(backend)?;
+        self.solver.restore(&state).map_err(backend)?;
         // A seed-dependent start: 0-63 control intervals further on.
         let offset = (splitmix64(seed) % 64) as usize * self.substeps;
         for _ in 0..offset {

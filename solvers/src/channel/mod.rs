@@ -21,5 +21,5 @@ pub mod stats;
 
 pub use error::ChannelError;
 pub use grid::{Grid, Top};
-pub use solver::{viscous_dt_limit, Channel, ChannelConfig, Drive};
+pub use solver::{viscous_dt_limit, Channel, ChannelConfig, ChannelState, Drive};
 pub use stats::{PlaneSums, Profiles};

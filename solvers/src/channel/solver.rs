@@ -61,6 +61,15 @@ pub fn viscous_dt_limit(g: &Grid, nu: f64) -> f64 {
     0.9 * 2.51 / lam
 }
 
+/// A velocity field of a channel with its grid size (for caching developed flows).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ChannelState {
+    pub n: [usize; 3],
+    pub u: Vec<f64>,
+    pub v: Vec<f64>,
+    pub w: Vec<f64>,
+}
+
 pub struct Channel {
     grid: Grid,
     cfg: ChannelConfig,
@@ -189,6 +198,33 @@ impl Channel {
         let du = target - self.bulk_velocity();
         self.u.par_iter_mut().for_each(|u| *u += du);
         du
+    }
+
+    /// The current velocity field.
+    pub fn state(&self) -> ChannelState {
+        ChannelState {
+            n: self.cfg.n,
+            u: self.u.clone(),
+            v: self.v.clone(),
+            w: self.w.clone(),
+        }
+    }
+
+    /// Replaces the velocity, wall rows included, by a state of [`Channel::state`] bit for bit
+    /// (it is divergence-free already), so a run continued from a cached state is the run that
+    /// cached it.
+    pub fn restore(&mut self, s: &ChannelState) -> Result<(), ChannelError> {
+        let fits = s.n == self.cfg.n && s.u.len() == self.u.len() && s.v.len() == self.v.len() && s.w.len() == self.w.len();
+        if !fits {
+            return Err(ChannelError::config(
+                "n",
+                format!("a state of {:?} cells does not fit this {:?} grid", s.n, self.cfg.n),
+            ));
+        }
+        self.u.copy_from_slice(&s.u);
+        self.v.copy_from_slice(&s.v);
+        self.w.copy_from_slice(&s.w);
+        Ok(())
     }
 
     /// Sets wall-normal velocity on the wall faces, `nx nz` values each in `at(i, 0, k)` order
