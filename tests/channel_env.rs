@@ -90,3 +90,92 @@ fn bad_specs_and_actions_are_refused_naming_the_field() {
     a[3] = f64::NAN;
     assert!(matches!(env.step(&a), Err(EnvError::NonFiniteAction { index: 3, .. })));
 }
+
+/// One agent per patch: the agents' actions tile both walls, each sees its own patch at the
+/// centre of its window, and the local rewards (patches of equal area) average to the reward.
+#[test]
+fn agents_tile_the_walls_and_local_rewards_average_to_the_reward() {
+    let spec = short(channel::all().remove(1), 3);
+    let mut env = ChannelEnv::new(spec.clone(), Level::Coarse, None).unwrap();
+    let agents = env.agents().expect("the channel declares agents");
+    assert_eq!(agents.len(), spec.act_dim());
+    assert_eq!((agents.local_obs_dim(), agents.local_act_dim()), (18, 1));
+    for (i, (obs, act)) in agents.obs.iter().zip(&agents.act).enumerate() {
+        assert_eq!(act, &vec![i]);
+        assert_eq!(obs[8..10], [2 * i, 2 * i + 1], "agent {i}: its own patch is the window's centre");
+    }
+    env.reset(2).unwrap();
+    let a: Vec<f64> = (0..spec.act_dim()).map(|i| ((i * 13 % 7) as f64 - 3.0) / 3.0).collect();
+    let r = env.step(&a).unwrap();
+    let local = env.agent_rewards();
+    let mean = local.iter().sum::<f64>() / local.len() as f64;
+    assert!((mean - r.reward).abs() < 1e-12, "{mean} against {}", r.reward);
+    assert!(
+        local.iter().any(|l| (l - r.reward).abs() > 1e-3),
+        "local rewards differ between patches"
+    );
+    let mut bad = spec.clone();
+    bad.agents.window = 4;
+    assert!(bad.check().unwrap_err().contains("agents.window"));
+}
+
+/// `hgym train --env TCFMini_3D_Retau180 --algo td3` trains the agents through pseudo-environments
+/// and writes a shared policy that `hgym eval --policy DIR` runs on the whole channel.
+#[test]
+fn multi_agent_td3_trains_through_the_cli_and_evaluates() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = tmp.path().join("marl.toml");
+    std::fs::write(
+        &cfg,
+        "[train]\neval_every = 1\nfinal_eval_episodes = 1\n[env]\nspin_up = 4.0\nepisode_actions = 4\n\
+         [td3]\nhidden = [16, 16]\nbatch_size = 32\nlearning_starts = 256\ngradient_steps = 2\nn_envs = 1\n",
+    )
+    .unwrap();
+    let out = tmp.path().join("out");
+    let run = |args: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_hgym"))
+            .args(args)
+            .env("HGYM_CACHE", tmp.path().join("cache"))
+            .output()
+            .unwrap();
+        let text = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+        assert!(o.status.success(), "{args:?}: {text}");
+        text
+    };
+    let (cfg, out_s) = (cfg.to_str().unwrap(), out.to_str().unwrap());
+    // Two rounds of one 4-action episode of 128 agents.
+    run(&[
+        "train",
+        "--env",
+        "TCFMini_3D_Retau180",
+        "--algo",
+        "td3",
+        "--steps",
+        "1024",
+        "--config",
+        cfg,
+        "--out",
+        out_s,
+    ]);
+    let dir = out.join("TCFMini_3D_Retau180-td3-coarse/seed0");
+    let policy: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("policy.json")).unwrap()).unwrap();
+    assert_eq!(policy["agents"]["obs"].as_array().unwrap().len(), 128);
+    assert_eq!(policy["net"]["sizes"][0], 18);
+    let manifest: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["samples"], 1024);
+    let curve = std::fs::read_to_string(dir.join("curve.csv")).unwrap();
+    assert_eq!(curve.lines().count(), 3, "{curve}");
+    let text = run(&[
+        "eval",
+        "--env",
+        "TCFMini_3D_Retau180",
+        "--policy",
+        dir.to_str().unwrap(),
+        "--episodes",
+        "1",
+        "--config",
+        cfg,
+        "--json",
+    ]);
+    assert!(text.contains("drag_reduction_pct"), "{text}");
+}

@@ -22,6 +22,8 @@ pub struct DdpgConfig {
     pub ou_theta: f64,
     pub ou_sigma: f64,
     pub n_envs: usize,
+    /// As TD3's.
+    pub gradient_steps: Option<usize>,
 }
 
 impl Default for DdpgConfig {
@@ -39,6 +41,7 @@ impl Default for DdpgConfig {
             ou_theta: 0.15,
             ou_sigma: 0.2,
             n_envs: t.n_envs,
+            gradient_steps: t.gradient_steps,
         }
     }
 }
@@ -61,6 +64,7 @@ pub fn ddpg(cfg: &DdpgConfig, obs_dim: usize, act_dim: usize, seed: u64) -> Td3 
         target_noise: 0.0,
         target_noise_clip: 0.0,
         n_envs: cfg.n_envs,
+        gradient_steps: cfg.gradient_steps,
     };
     Td3::new("ddpg", t, obs_dim, act_dim, seed)
 }

@@ -4,6 +4,7 @@ use std::collections::BTreeMap;
 
 use thiserror::Error;
 
+use crate::multi::Agents;
 use crate::spaces::BoxSpace;
 
 /// Extra facts of a reset or step: at least `t`, force coefficients and the physical actuation
@@ -87,6 +88,26 @@ pub trait Env {
     fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError>;
     /// Applies one action for one control interval.
     fn step(&mut self, action: &[f64]) -> Result<StepResult, EnvError>;
+    /// How the environment splits into agents for multi-agent training ([`crate::multi`]), if
+    /// it does.
+    fn agents(&self) -> Option<Agents> {
+        None
+    }
+    /// The last step's reward of each of [`Env::agents`] (local rewards); empty when the
+    /// environment has none.
+    fn agent_rewards(&self) -> Vec<f64> {
+        vec![]
+    }
+    /// Hands over the action of the next `step` before it (the first of two phases of
+    /// [`crate::rollout::step_all`]). Pseudo-environments sharing one flow step it here, once
+    /// all their agents have handed theirs over; an ordinary environment does nothing.
+    fn submit(&mut self, _action: &[f64]) -> Result<(), EnvError> {
+        Ok(())
+    }
+    /// [`Env::submit`] for `reset`.
+    fn submit_reset(&mut self, _seed: u64) -> Result<(), EnvError> {
+        Ok(())
+    }
 }
 
 /// The differentiable extension of the contract (the paper's JAX environments): the env keeps
@@ -116,6 +137,22 @@ impl<E: Env + ?Sized> Env for Box<E> {
     fn step(&mut self, action: &[f64]) -> Result<StepResult, EnvError> {
         (**self).step(action)
     }
+
+    fn agents(&self) -> Option<Agents> {
+        (**self).agents()
+    }
+
+    fn agent_rewards(&self) -> Vec<f64> {
+        (**self).agent_rewards()
+    }
+
+    fn submit(&mut self, action: &[f64]) -> Result<(), EnvError> {
+        (**self).submit(action)
+    }
+
+    fn submit_reset(&mut self, seed: u64) -> Result<(), EnvError> {
+        (**self).submit_reset(seed)
+    }
 }
 
 impl<E: DifferentiableEnv + ?Sized> DifferentiableEnv for Box<E> {
@@ -139,6 +176,22 @@ impl<E: Env + ?Sized> Env for &mut E {
 
     fn step(&mut self, action: &[f64]) -> Result<StepResult, EnvError> {
         (**self).step(action)
+    }
+
+    fn agents(&self) -> Option<Agents> {
+        (**self).agents()
+    }
+
+    fn agent_rewards(&self) -> Vec<f64> {
+        (**self).agent_rewards()
+    }
+
+    fn submit(&mut self, action: &[f64]) -> Result<(), EnvError> {
+        (**self).submit(action)
+    }
+
+    fn submit_reset(&mut self, seed: u64) -> Result<(), EnvError> {
+        (**self).submit_reset(seed)
     }
 }
 

@@ -8,7 +8,8 @@
 //!
 //! Learning: [`nn`] (MLP with backward pass and Adam), [`ppo`], [`ddpg`], [`td3`] (one algorithm
 //! per file), classical controllers in [`baselines`], rounds of parallel episodes in
-//! [`rollout`], one type over the learners with checkpoint bytes in [`learn`], and small control
+//! [`rollout`], one type over the learners with checkpoint bytes in [`learn`], one environment split into
+//! agents that share a policy in [`multi`], and small control
 //! tasks for tests in [`toy`].
 
 pub mod baselines;
@@ -18,6 +19,7 @@ pub mod ddpg;
 mod env;
 pub mod gppo;
 pub mod learn;
+pub mod multi;
 pub mod nn;
 pub mod noise;
 pub mod normalize;

@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::env::Info;
+use crate::multi::Agents;
 use crate::nn::{Mlp, Tape};
 use crate::normalize::RunningMeanStd;
 
@@ -28,13 +29,17 @@ pub struct ActorPolicy {
     pub net: Mlp<f32>,
     pub obs_norm: Option<RunningMeanStd>,
     pub obs_clip: f64,
+    /// A policy shared by agents ([`crate::multi`]): the network maps one agent's local
+    /// observation to its local action and acts for every agent of the global environment.
+    #[serde(default)]
+    pub agents: Option<Agents>,
     #[serde(skip)]
     scratch: Scratch,
 }
 
 #[derive(Clone, Debug, Default)]
 struct Scratch {
-    x: Vec<f64>,
+    local: Vec<f64>,
     x32: Vec<f32>,
     tape: Tape<f32>,
 }
@@ -46,8 +51,15 @@ impl ActorPolicy {
             net,
             obs_norm,
             obs_clip,
+            agents: None,
             scratch: Scratch::default(),
         }
+    }
+
+    /// This (local) actor acting for every agent of `agents`.
+    pub fn with_agents(mut self, agents: Agents) -> Self {
+        self.agents = Some(agents);
+        self
     }
 
     /// Whether a policy read from a file is whole: its network ([`Mlp::check`]), an observation
@@ -70,31 +82,75 @@ impl ActorPolicy {
         if !(self.obs_clip.is_finite() && self.obs_clip > 0.0) {
             return Err(format!("obs_clip must be positive, got {}", self.obs_clip));
         }
+        if let Some(a) = &self.agents {
+            a.check().map_err(|m| format!("agents: {m}"))?;
+            if (a.local_obs_dim(), a.local_act_dim()) != (self.net.input_dim(), self.net.output_dim()) {
+                return Err(format!(
+                    "agents see {} observations and set {} actions each, but the network maps {} to {}",
+                    a.local_obs_dim(),
+                    a.local_act_dim(),
+                    self.net.input_dim(),
+                    self.net.output_dim()
+                ));
+            }
+        }
         Ok(())
     }
 
+    /// The global observation dimension it acts on.
     pub fn obs_dim(&self) -> usize {
-        self.net.input_dim()
+        self.agents.as_ref().map_or(self.net.input_dim(), |a| a.obs_dim)
     }
 
     pub fn act_dim(&self) -> usize {
-        self.net.output_dim()
+        self.agents.as_ref().map_or(self.net.output_dim(), |a| a.act_dim)
     }
 }
 
 impl Policy for ActorPolicy {
+    /// One forward pass; with agents, one batch row per agent (its local observation), each
+    /// row's output scattered into the agent's actions.
     fn act(&mut self, obs: &[f64], _info: &Info, action: &mut [f64]) {
         let s = &mut self.scratch;
-        s.x.clear();
-        s.x.extend_from_slice(obs);
-        if let Some(n) = &self.obs_norm {
-            n.normalize(&mut s.x, self.obs_clip);
-        }
         s.x32.clear();
-        s.x32.extend(s.x.iter().map(|v| *v as f32));
-        let y = self.net.forward(&s.x32, 1, &mut s.tape);
-        for (a, y) in action.iter_mut().zip(y) {
-            *a = (*y as f64).clamp(-1.0, 1.0);
+        let rows = match &self.agents {
+            None => {
+                s.local.clear();
+                s.local.extend_from_slice(obs);
+                push_row(&mut s.x32, &mut s.local, self.obs_norm.as_ref(), self.obs_clip);
+                1
+            }
+            Some(agents) => {
+                for i in 0..agents.len() {
+                    agents.gather(i, obs, &mut s.local);
+                    push_row(&mut s.x32, &mut s.local, self.obs_norm.as_ref(), self.obs_clip);
+                }
+                agents.len()
+            }
+        };
+        let y = self.net.forward(&s.x32, rows, &mut s.tape);
+        match &self.agents {
+            None => {
+                for (a, y) in action.iter_mut().zip(y) {
+                    *a = (*y as f64).clamp(-1.0, 1.0);
+                }
+            }
+            Some(agents) => {
+                let m = agents.local_act_dim();
+                for (i, row) in y.chunks(m).enumerate() {
+                    s.local.clear();
+                    s.local.extend(row.iter().map(|y| (*y as f64).clamp(-1.0, 1.0)));
+                    agents.scatter(i, &s.local, action);
+                }
+            }
         }
     }
+}
+
+/// Appends `x`, normalised, to the network's f32 input.
+fn push_row(input: &mut Vec<f32>, x: &mut [f64], norm: Option<&RunningMeanStd>, clip: f64) {
+    if let Some(n) = norm {
+        n.normalize(x, clip);
+    }
+    input.extend(x.iter().map(|v| *v as f32));
 }

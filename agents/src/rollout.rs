@@ -55,8 +55,14 @@ impl EpisodeAccumulator {
 
 /// Steps every environment whose `active` flag is set with its action, in parallel; inactive
 /// environments return `None`. The order of results is the order of the environments, so the
-/// outcome does not depend on the number of threads.
+/// outcome does not depend on the number of threads. The actions are first handed over in
+/// order ([`Env::submit`]: multi-agent pseudo-environments step their shared flow there).
 pub fn step_all<E: Env + Send>(envs: &mut [E], actions: &[Vec<f64>], active: &[bool]) -> Result<Vec<Option<StepResult>>, EnvError> {
+    for ((env, a), on) in envs.iter_mut().zip(actions).zip(active) {
+        if *on {
+            env.submit(a)?;
+        }
+    }
     envs.par_iter_mut()
         .zip(actions.par_iter())
         .zip(active.par_iter())
@@ -64,8 +70,11 @@ pub fn step_all<E: Env + Send>(envs: &mut [E], actions: &[Vec<f64>], active: &[b
         .collect()
 }
 
-/// Resets every environment with its seed, in parallel.
+/// Resets every environment with its seed, in parallel (after [`Env::submit_reset`] in order).
 pub fn reset_all<E: Env + Send>(envs: &mut [E], seeds: &[u64]) -> Result<Vec<(Vec<f64>, Info)>, EnvError> {
+    for (env, s) in envs.iter_mut().zip(seeds) {
+        env.submit_reset(*s)?;
+    }
     envs.par_iter_mut().zip(seeds.par_iter()).map(|(env, s)| env.reset(*s)).collect()
 }
 

@@ -5,7 +5,8 @@
 //! no delay and Ornstein-Uhlenbeck exploration; [`crate::ddpg`] builds it from here.
 //!
 //! Collection: every environment steps in parallel; each transition is followed by one
-//! gradient update (SB3's `train_freq = 1`, `gradient_steps = 1` per environment step).
+//! gradient update (SB3's `train_freq = 1`, `gradient_steps = 1` per environment step), or
+//! `gradient_steps` updates follow each lockstep step of all environments.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -45,6 +46,10 @@ pub struct Td3Config {
     pub target_noise_clip: f64,
     /// Environments stepped in parallel.
     pub n_envs: usize,
+    /// Gradient updates after each lockstep step of the environments; absent: one per collected
+    /// transition (SB3's `gradient_steps = -1`). Multi-agent runs collect one transition per
+    /// agent per step and set a number here.
+    pub gradient_steps: Option<usize>,
 }
 
 impl Default for Td3Config {
@@ -65,6 +70,7 @@ impl Default for Td3Config {
             target_noise: 0.2,
             target_noise_clip: 0.5,
             n_envs: 2,
+            gradient_steps: None,
         }
     }
 }
@@ -206,6 +212,12 @@ impl Td3 {
         let n = envs.len();
         let seeds: Vec<u64> = (0..n).map(|i| episode_seed(self.seed, self.round, i)).collect();
         let mut obs: Vec<Vec<f64>> = reset_all(envs, &seeds)?.into_iter().map(|(o, _)| o).collect();
+        if let Some((theta, sigma)) = self.cfg.ou_noise {
+            // One process per environment, however many the round brings (multi-agent runs).
+            while self.ou.len() < n {
+                self.ou.push(OrnsteinUhlenbeck::new(self.act_dim, theta, sigma));
+            }
+        }
         self.ou.iter_mut().for_each(|o| o.reset());
         let mut active = vec![true; n];
         let mut actions = vec![vec![0.0; self.act_dim]; n];
@@ -232,7 +244,7 @@ impl Td3 {
                 obs[i] = r.obs;
             }
             if self.samples as usize >= self.cfg.learning_starts {
-                for _ in 0..collected {
+                for _ in 0..self.cfg.gradient_steps.unwrap_or(collected) {
                     self.update();
                 }
             }

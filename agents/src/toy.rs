@@ -1,6 +1,7 @@
 //! Cheap control tasks for testing learners in seconds (no flows: they live in `hgym`).
 
 use crate::env::{checked_action, DifferentiableEnv, Env, EnvError, Info, StepResult};
+use crate::multi::{AgentReward, Agents};
 use crate::rng::Rng;
 use crate::spaces::BoxSpace;
 
@@ -120,6 +121,96 @@ impl DifferentiableEnv for Oscillator {
             lv = lv1 * (1.0 + dt * 2.0 * z * w);
         }
         Ok(out)
+    }
+}
+
+/// `n` independent [`Oscillator`]s in one environment, each its own agent
+/// ([`crate::multi`]): observation `(x_0, v_0, x_1, v_1, ...)`, action `(u_0, u_1, ...)`, reward
+/// the mean of the oscillators' rewards, each oscillator's reward its agent's local one. The
+/// oscillator `i` starts from the seed `seed + i`; the episode ends when the first one does.
+#[derive(Clone, Debug)]
+pub struct Oscillators {
+    parts: Vec<Oscillator>,
+    rewards: Vec<f64>,
+    reward: AgentReward,
+}
+
+impl Oscillators {
+    pub fn new(n: usize, reward: AgentReward) -> Self {
+        Oscillators {
+            parts: vec![Oscillator::default(); n],
+            rewards: vec![0.0; n],
+            reward,
+        }
+    }
+}
+
+impl Env for Oscillators {
+    fn observation_space(&self) -> BoxSpace {
+        BoxSpace::uniform(2 * self.parts.len(), -10.0, 10.0)
+    }
+
+    fn action_space(&self) -> BoxSpace {
+        BoxSpace::unit(self.parts.len())
+    }
+
+    fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
+        let mut obs = vec![];
+        for (i, p) in self.parts.iter_mut().enumerate() {
+            obs.extend(p.reset(seed.wrapping_add(i as u64))?.0);
+        }
+        let mut info = Info::default();
+        info.set("t", 0.0);
+        Ok((obs, info))
+    }
+
+    fn step(&mut self, action: &[f64]) -> Result<StepResult, EnvError> {
+        let (a, clipped) = checked_action(&self.action_space(), action)?;
+        let mut out = StepResult {
+            obs: vec![],
+            reward: 0.0,
+            terminated: false,
+            truncated: false,
+            info: Info::default(),
+        };
+        for (i, p) in self.parts.iter_mut().enumerate() {
+            let r = p.step(&a[i..i + 1])?;
+            out.obs.extend(r.obs);
+            self.rewards[i] = r.reward;
+            out.terminated |= r.terminated;
+            out.truncated |= r.truncated;
+            out.info = r.info;
+        }
+        out.truncated &= !out.terminated;
+        if out.terminated || out.truncated {
+            // Every oscillator's episode ends with the first one's.
+            self.parts.iter_mut().for_each(|p| p.live = false);
+        }
+        out.reward = self.rewards.iter().sum::<f64>() / self.parts.len() as f64;
+        out.info.set("clipped", clipped as f64);
+        Ok(out)
+    }
+
+    fn agents(&self) -> Option<Agents> {
+        let n = self.parts.len();
+        Agents::new(
+            2 * n,
+            n,
+            (0..n).map(|i| vec![2 * i, 2 * i + 1]).collect(),
+            (0..n).map(|i| vec![i]).collect(),
+            self.reward,
+        )
+        .ok()
+    }
+
+    fn agent_rewards(&self) -> Vec<f64> {
+        self.rewards.clone()
+    }
+}
+
+impl DifferentiableEnv for Oscillators {
+    fn reward_action_gradients(&mut self, _k: usize) -> Result<Vec<Vec<f64>>, EnvError> {
+        Err(EnvError::Backend("Oscillators has no adjoint".into()))
     }
 }
 

@@ -5,11 +5,12 @@
 use hgym_agents::baselines::{Baseline, BaselinePolicy, Signal};
 use hgym_agents::ddpg::DdpgConfig;
 use hgym_agents::learn::{algorithm, AlgoConfigs, Learner};
+use hgym_agents::multi::{pseudo_envs, AgentReward};
 use hgym_agents::policy::Policy;
 use hgym_agents::ppo::PpoConfig;
 use hgym_agents::rollout::episode;
 use hgym_agents::td3::Td3Config;
-use hgym_agents::toy::Oscillator;
+use hgym_agents::toy::{Oscillator, Oscillators};
 
 const EVAL_SEEDS: [u64; 8] = [1001, 1002, 1003, 1004, 1005, 1006, 1007, 1008];
 
@@ -119,6 +120,47 @@ fn ppo_stabilises_the_oscillator() {
 #[test]
 fn gppo_stabilises_the_oscillator() {
     check("gppo", 60);
+}
+
+/// Multi-agent: four oscillators in one environment, one agent each, sharing one policy trained
+/// through pseudo-environments (one replay buffer or rollout); the shared actor must stabilise
+/// a lone oscillator as well as single-agent training does, on the same eight states.
+fn check_multi_agent(algo: &str, reward: AgentReward, rounds: u64) {
+    let (zero, pd) = references();
+    let mut cfg = small();
+    for section in ["td3", "ddpg"] {
+        let mut v = cfg.0[section].clone();
+        v["gradient_steps"] = serde_json::json!(2);
+        cfg.0.insert(section.into(), v);
+    }
+    let mut envs = pseudo_envs(Oscillators::new(4, reward)).unwrap();
+    let mut learner = algorithm(algo).unwrap().learner(&cfg, 2, 1, 5).unwrap();
+    for _ in 0..rounds {
+        learner.round_on(&mut envs).unwrap();
+    }
+    let ret = mean_return(&mut learner.policy());
+    println!(
+        "{algo} through 4 agents ({reward:?} reward): return {ret:.2} after {} samples, {} updates",
+        learner.samples(),
+        learner.updates()
+    );
+    let bar = zero + 0.95 * (pd - zero);
+    assert!(ret > bar, "{algo} multi-agent: return {ret:.3} below {bar:.3}");
+}
+
+#[test]
+fn td3_learns_through_pseudo_environments() {
+    check_multi_agent("td3", AgentReward::Local, 30);
+}
+
+#[test]
+fn ddpg_learns_through_pseudo_environments() {
+    check_multi_agent("ddpg", AgentReward::Local, 30);
+}
+
+#[test]
+fn ppo_learns_through_pseudo_environments() {
+    check_multi_agent("ppo", AgentReward::Global, 30);
 }
 
 /// Kill after K rounds (checkpoint bytes), resume, finish: the same learner, bitwise.

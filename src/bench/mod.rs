@@ -11,10 +11,14 @@
 //! single-thread rows are reported beside it (one core is bound by arithmetic, not memory: its
 //! rate from memory matches its rate from the last-level cache).
 //!
+//! `hgym bench channel`: the channel DNS's simulated time per wall-clock second
+//! ([`channel`]), and with `--peer` against HydroGym's JAX channel.
+//!
 //! `hgym bench refine`: the cost of 2:1 grid refinement's coupling, as the ratio of a refined
 //! grid's node updates per second to the uniform kernel's on the same coarse grid, same run.
 
 pub mod agents;
+pub mod channel;
 pub mod envs;
 pub mod kolmogorov;
 mod lbm;

@@ -20,6 +20,8 @@ use thiserror::Error;
 pub const SB3_TD3: (&str, &str) = ("sb3_td3.py", include_str!("../../scripts/peers/sb3_td3.py"));
 /// HydroGym's JAX Kolmogorov environment.
 pub const HYDROGYM_KOLMOGOROV: (&str, &str) = ("hydrogym_kolmogorov.py", include_str!("../../scripts/peers/hydrogym_kolmogorov.py"));
+/// HydroGym's JAX channel.
+pub const HYDROGYM_CHANNEL: (&str, &str) = ("hydrogym_channel.py", include_str!("../../scripts/peers/hydrogym_channel.py"));
 
 #[derive(Debug, Error)]
 pub enum PeerError {

@@ -61,6 +61,12 @@ pub enum BenchCommand {
     /// alternating with ours, with each one's step size and accuracy per control action. Exit 1 if
     /// a VJP costs more than 3 steps; 2 if --peer is given and the peers are not installed.
     Kolmogorov(#[command(flatten)] PeerBenchArgs),
+    /// Channel DNS: steps/s and simulated t+ per second at the minimal and the full box (default
+    /// grids), 1 and 2 threads. With --peer, HydroGym's JAX channel (72^3, its box) is timed in
+    /// the same run, alternating with ours on its grid, per simulated time unit with each one's
+    /// step stated. Exit 1 if that ratio is below 5x; 2 if --peer is given and the peers are not
+    /// installed.
+    Channel(#[command(flatten)] PeerBenchArgs),
     /// hgym from Python: the boundary's overhead per step (HgymEnv.step against the same env
     /// stepped in Rust, alternating) and the vector env's throughput against the Rust loop, 1 and
     /// 2 threads. Needs the package (`make python`; the interpreter is $HGYM_PYTHON, else
@@ -169,6 +175,18 @@ pub fn run(cmd: BenchCommand) -> Result<Outcome> {
             let mut peer = start_peer(peer, hgym::bench::peer::HYDROGYM_KOLMOGOROV, n)?;
             let b = pool.install(|| hgym::bench::kolmogorov::bench_kolmogorov(quick, peer.as_mut()))?;
             print_report(json, &b, &hgym::bench::kolmogorov::table(&b))?;
+            Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
+        }
+        BenchCommand::Channel(PeerBenchArgs {
+            json,
+            quick,
+            threads,
+            peer,
+        }) => {
+            let (pool, n) = thread_pool(threads)?;
+            let mut peer = start_peer(peer, hgym::bench::peer::HYDROGYM_CHANNEL, n)?;
+            let b = pool.install(|| hgym::bench::channel::bench_channel(quick, n, peer.as_mut()))?;
+            print_report(json, &b, &hgym::bench::channel::table(&b))?;
             Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
         }
     }

@@ -24,6 +24,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 
+use hgym_agents::multi::{AgentReward, Agents};
 use hgym_agents::{checked_action, BoxSpace, DifferentiableEnv, Env, EnvError, Info, StepResult};
 use hgym_solvers::channel::{viscous_dt_limit, Channel, ChannelConfig, ChannelState as State, Drive, Grid, Top};
 use serde::{Deserialize, Serialize};
@@ -75,8 +76,31 @@ pub struct ChannelSpec {
     pub episode_actions: usize,
     /// Uncontrolled time (h/U_b) from the disturbed laminar flow to developed turbulence.
     pub spin_up: f64,
+    /// The agents of multi-agent training: one per patch.
+    #[serde(default)]
+    pub agents: ChannelAgents,
     #[serde(default)]
     pub statistics: ChannelStatistics,
+}
+
+/// One agent per actuator patch (`hgym train` trains one policy they share, `hgym_agents::multi`).
+/// An agent sees `u'` and `v'` above the `(2 window + 1)^2` patches centred on its own, on its
+/// own wall (periodic in x and z), rows in z, x fastest, and learns from the global reward or
+/// its own `1 - tau_w,patch / tau_w,ref` (the patches tile the wall without overlap).
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ChannelAgents {
+    pub window: usize,
+    pub reward: AgentReward,
+}
+
+impl Default for ChannelAgents {
+    fn default() -> Self {
+        ChannelAgents {
+            window: 1,
+            reward: AgentReward::Local,
+        }
+    }
 }
 
 impl ChannelSpec {
@@ -115,6 +139,14 @@ impl ChannelSpec {
                     "the {} grid puts its first cell centre at y+ = {first:.2}; a wall-resolved flow needs y+ <= 1 \
                      (more cells in y or a larger `stretch`)",
                     level.name()
+                ));
+            }
+            let side = 2 * self.agents.window + 1;
+            if side > self.patches[0] || side > self.patches[1] {
+                return Err(format!(
+                    "agents.window = {} sees {side}x{side} patches, more than the {:?} patches of a wall: \
+                     take a smaller window",
+                    self.agents.window, self.patches
                 ));
             }
             if self.sensing_y_plus / self.re_tau >= g.ly * 0.5 {
@@ -257,6 +289,7 @@ pub fn all() -> Vec<ChannelSpec> {
         control_interval_plus: 0.6,
         episode_actions: 2500,
         spin_up: 150.0,
+        agents: ChannelAgents::default(),
         statistics: ChannelStatistics::default(),
     };
     let full = base(
@@ -395,6 +428,8 @@ pub struct ChannelEnv {
     /// Per-wall-cell scratch: the transpiration of each wall, then the sensing plane's u' and v'.
     plane: [Vec<f64>; 2],
     shear: [Vec<f64>; 2],
+    /// Each patch's wall shear stress, averaged over the last interval (the agents' rewards).
+    patch_tau: Vec<f64>,
 }
 
 impl ChannelEnv {
@@ -430,6 +465,7 @@ impl ChannelEnv {
             substeps,
             plane: [vec![0.0; wall_cells], vec![0.0; wall_cells]],
             shear: [vec![0.0; wall_cells], vec![0.0; wall_cells]],
+            patch_tau: vec![0.0; spec.act_dim()],
             spec,
             level,
             cache,
@@ -567,6 +603,23 @@ impl ChannelEnv {
         let sum: f64 = b.iter().sum::<f64>() + if walls == 2 { t.iter().sum::<f64>() } else { 0.0 };
         sum / (b.len() * walls) as f64
     }
+
+    /// Adds `weight` times each patch's mean of the wall shear stress [`ChannelEnv::tau_w`]
+    /// last computed to `patch_tau`.
+    fn add_patch_shear(&mut self, weight: f64) {
+        let (nx, nz) = (self.solver.grid().nx, self.solver.grid().nz);
+        let [px, pz] = self.spec.patches;
+        let (bx, bz) = (nx / px, nz / pz);
+        let w = weight / (bx * bz) as f64;
+        for wall in 0..self.spec.walls() {
+            let patches = &mut self.patch_tau[wall * px * pz..(wall + 1) * px * pz];
+            for k in 0..nz {
+                for i in 0..nx {
+                    patches[(k / bz) * px + i / bx] += w * self.shear[wall][k * nx + i];
+                }
+            }
+        }
+    }
 }
 
 impl Env for ChannelEnv {
@@ -633,12 +686,14 @@ impl Env for ChannelEnv {
         self.solver.set_transpiration(bottom, top).map_err(backend)?;
         let mut tau = 0.0;
         let mut failure = None;
+        self.patch_tau.fill(0.0);
         for _ in 0..self.substeps {
             if let Err(e) = self.solver.step() {
                 failure = Some(e.to_string());
                 break;
             }
             tau += self.tau_w() / self.substeps as f64;
+            self.add_patch_shear(1.0 / self.substeps as f64);
         }
         self.actions += 1;
         let mut info = Info::default();
@@ -684,6 +739,36 @@ impl Env for ChannelEnv {
             truncated,
             info,
         })
+    }
+
+    /// One agent per patch ([`ChannelAgents`]); the patch numbering is the action's.
+    fn agents(&self) -> Option<Agents> {
+        let [px, pz] = self.spec.patches;
+        let w = self.spec.agents.window as isize;
+        let (mut obs, mut act) = (vec![], vec![]);
+        for wall in 0..self.spec.walls() {
+            for qz in 0..pz {
+                for qx in 0..px {
+                    let mut seen = vec![];
+                    for dz in -w..=w {
+                        for dx in -w..=w {
+                            let z = (qz as isize + dz).rem_euclid(pz as isize) as usize;
+                            let x = (qx as isize + dx).rem_euclid(px as isize) as usize;
+                            let q = wall * px * pz + z * px + x;
+                            seen.extend([2 * q, 2 * q + 1]);
+                        }
+                    }
+                    obs.push(seen);
+                    act.push(vec![wall * px * pz + qz * px + qx]);
+                }
+            }
+        }
+        Agents::new(self.spec.obs_dim(), self.spec.act_dim(), obs, act, self.spec.agents.reward).ok()
+    }
+
+    /// `1 - tau_w,patch / tau_w,ref` per patch over the last interval.
+    fn agent_rewards(&self) -> Vec<f64> {
+        self.patch_tau.iter().map(|t| 1.0 - t / self.tau_ref).collect()
     }
 }
 

@@ -26,6 +26,10 @@ pub struct TrainSettings {
     /// Flow-field snapshots (u, v, vorticity) in the final evaluation's trajectory.mcap at each
     /// reset and every this many actions (0: none).
     pub fields_every: u64,
+    /// Train a flow that declares agents (the channel flows: one per actuator patch) as agents
+    /// sharing one policy, each transition of each agent a sample (so `steps` counts agent
+    /// transitions); false: one policy for the whole action.
+    pub multi_agent: bool,
 }
 
 impl Default for TrainSettings {
@@ -38,6 +42,7 @@ impl Default for TrainSettings {
             eval_seed: 1_000_000,
             checkpoint_seconds: 60.0,
             fields_every: 0,
+            multi_agent: true,
         }
     }
 }

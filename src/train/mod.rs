@@ -4,8 +4,11 @@
 //!
 //! - `manifest.json`: env spec and hash, algorithm, configuration, seed, samples, code version,
 //!   machine, wall time;
-//! - `curve.csv`, `curve.png`, `drag_reduction.png`: the learning curve;
+//! - `curve.csv`, `curve.png`, `drag_reduction.png`: the learning curve (the CSV also at every
+//!   checkpoint, to follow a long run);
 //! - `policy.json`: the final deterministic policy (`hgym eval --policy DIR` loads it);
+//!   for a flow that declares agents (`hgym_agents::multi`: the channel flows), one actor shared
+//!   by every agent, trained through one pseudo-environment per agent (`[train] multi_agent`);
 //! - `metrics.json`: the final evaluation ([`eval::EvalReport`]);
 //! - `init_from.json`: for a run started from another run's policy (`--init-from`), where it
 //!   started and how the source was mapped (also in the manifest); such a run evaluates its
@@ -24,7 +27,9 @@ pub mod eval;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use hgym_agents::learn::{algorithm, Learner};
+use hgym_agents::learn::{algorithm, Learner, ParallelEnv};
+use hgym_agents::multi::pseudo_envs;
+use hgym_agents::policy::ActorPolicy;
 use hgym_agents::EnvError;
 use serde::{Deserialize, Serialize};
 
@@ -188,20 +193,37 @@ pub fn train(
     let started = Instant::now();
     let config = &opts.config;
     let spec = resolve_spec(&opts.env_id, config)?;
-    let (obs_dim, act_dim) = (spec.obs_dim(), spec.act_dim());
     let algo = algorithm(&opts.algo).map_err(|e| TrainError::Input(e.to_string()))?;
     let n_envs = algo.n_envs(&config.algos)?;
     std::fs::create_dir_all(&opts.out).map_err(io(&opts.out))?;
     let make = || spec.make(opts.level, opts.cache.clone());
-    let mut envs: Vec<Box<dyn FlowEnv>> = (0..n_envs).map(|_| make()).collect::<Result<_, _>>()?;
     let mut eval_env = make()?;
+    // A flow that declares agents trains them as pseudo-environments sharing one policy: the
+    // learner sees one agent's spaces, and the policy acts for all of them on the whole flow.
+    let agents = if config.train.multi_agent { eval_env.agents() } else { None };
+    let (obs_dim, act_dim) = match &agents {
+        Some(a) => (a.local_obs_dim(), a.local_act_dim()),
+        None => (spec.obs_dim(), spec.act_dim()),
+    };
+    let mut envs: Vec<Box<dyn ParallelEnv>> = vec![];
+    for _ in 0..n_envs {
+        let env = make()?;
+        match agents {
+            Some(_) => envs.extend(pseudo_envs(env)?.into_iter().map(|p| Box::new(p) as Box<dyn ParallelEnv>)),
+            None => envs.push(Box::new(env)),
+        }
+    }
+    let shared = |p: ActorPolicy| match &agents {
+        Some(a) => p.with_agents(a.clone()),
+        None => p,
+    };
     let periodic_seeds = eval_seeds(config, config.train.eval_episodes.max(1));
     let hash = spec.hash();
     // The periodic evaluation of the learner's current policy: the curve's eval columns.
     let periodic_eval = |env: &mut Box<dyn FlowEnv>, learner: &dyn Learner, reference: &[f64]| {
         evaluate(
             env,
-            &mut learner.policy(),
+            &mut shared(learner.policy()),
             algo.name(),
             spec.id(),
             &hash,
@@ -263,8 +285,10 @@ pub fn train(
                 wall_s,
                 resumed,
             },
-        )
-        .map_err(TrainError::from)
+        )?;
+        // The curve so far, to follow a long run from another terminal.
+        let csv = opts.out.join("curve.csv");
+        std::fs::write(&csv, curve::to_csv(curve)).map_err(io(&csv))
     };
     // A resumed run records itself at once (so `resumed` counts every resume, even one killed
     // before its first round); every run saves after its first round, then every
@@ -328,7 +352,7 @@ pub fn train(
     // Final evaluation on its own seeds, against the uncontrolled flow from the same states.
     let final_seeds = eval_seeds(config, config.train.final_eval_episodes.max(1));
     let final_ref = uncontrolled_c_d(&mut eval_env, &final_seeds)?;
-    let mut policy = learner.policy();
+    let mut policy = shared(learner.policy());
     let hash = spec.hash();
     let mut trajectory = crate::data::trajectory::TrajectoryWriter::create(
         &opts.out.join("trajectory.mcap"),

@@ -121,6 +121,19 @@ impl SourceRun {
     pub fn onto(&self, target: &Spec, mapping: &MappingSpec) -> Result<(SpaceMap, ActorPolicy), TransferError> {
         let map = resolve((&self.env_id, &self.spec.layout()), (target.id(), &target.layout()), mapping)?;
         let p = &self.policy;
+        if p.agents.is_some() {
+            // A shared actor reads one agent's neighbourhood, not the whole flow: it moves only
+            // onto the flow it was trained on.
+            return match map.is_identity() {
+                true => Ok((map, p.clone())),
+                false => Err(TransferError::Source(format!(
+                    "{} holds a multi-agent policy (one actor per actuator patch); moving it to {} \
+                     through a map of whole observations is not supported",
+                    self.dir.display(),
+                    target.id()
+                ))),
+            };
+        }
         let policy = ActorPolicy::new(
             &p.algo,
             map.actor(&p.net),
