@@ -41,7 +41,7 @@ $(VENV)/.installed: scripts/requirements-test.txt
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r $<
 	@touch $@
 
-# The peers `hgym bench agents --peer` and `hgym bench kolmogorov --peer` time beside ours, in a
+# The peers `hgym bench agents|kolmogorov|channel --peer` time beside ours, in a
 # venv of their own: hydrogym 1.0.0 pins huggingface-hub 0.16 and pandas 2.3, which break the
 # `datasets` the tests read exports with. The gymnax 1.0.1 incompatibility of hydrogym 1.0.0 is adapted
 # in scripts/peers/hydrogym_kolmogorov.py, not patched into the installed files.

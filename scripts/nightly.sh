@@ -30,6 +30,7 @@ step bench-lbm        "$HGYM" bench lbm
 step bench-refine     "$HGYM" bench refine
 step bench-agents     "$HGYM" bench agents
 step bench-kolmogorov "$HGYM" bench kolmogorov
+step bench-channel    "$HGYM" bench channel
 step bench-envs       "$HGYM" bench envs --quick
 step bench-python     "$HGYM" bench python
 for algo in ppo ddpg td3 gppo; do
