@@ -179,3 +179,33 @@ fn multi_agent_td3_trains_through_the_cli_and_evaluates() {
     ]);
     assert!(text.contains("drag_reduction_pct"), "{text}");
 }
+
+/// `hgym run` on a channel: the wall shear stress map and the sensing-plane fields as images;
+/// a box below the minimal flow unit runs with a warning that names the sizes.
+#[test]
+fn run_draws_the_wall_shear_stress() {
+    use hgym::env::family::FamilySpec;
+    assert!(channel::all().iter().all(|s| s.warnings().is_empty()));
+    let tmp = tempfile::tempdir().unwrap();
+    let cfg = tmp.path().join("short.toml");
+    std::fs::write(&cfg, "[env]\nspin_up = 4.0\nlength = [1.2, 2.0, 0.4]\n").unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_hgym"))
+        .args(["run", "--env", "TCFMini_3D_Retau180", "--res", "coarse", "--steps", "3", "--policy", "random"])
+        .arg("--config")
+        .arg(&cfg)
+        .arg("--out")
+        .arg(tmp.path())
+        .env("HGYM_CACHE", tmp.path().join("cache"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(stderr.contains("warning: TCFMini_3D_Retau180: the box is Lx+ 216 by Lz+ 72"), "{stderr}");
+    assert!(stderr.contains("length[0] >= 1.39"), "{stderr}");
+    let dir = tmp.path().join("TCFMini_3D_Retau180-random-seed0");
+    for f in ["manifest.json", "metrics.json", "rollout.png", "tau_w_excess.png", "u_sensing.png", "trajectory.mcap"] {
+        assert!(dir.join(f).exists(), "{f} missing");
+    }
+    let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!((m["actions_run"].as_u64(), m["spec"]["re_tau"].as_f64()), (Some(3), Some(180.0)));
+}

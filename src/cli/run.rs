@@ -1,5 +1,5 @@
-//! `hgym run`: one episode of a fixed policy on a lattice-Boltzmann environment, written as
-//! metrics, plots, a trajectory and a manifest.
+//! `hgym run`: one episode of a fixed policy on an environment of any family, written as
+//! metrics, plots (the final flow's fields as images), a trajectory and a manifest.
 
 use std::path::PathBuf;
 
@@ -48,29 +48,14 @@ pub fn run(args: RunArgs) -> Result<Outcome> {
             hgym::train::config::TrainConfig::parse(&text, &p.display().to_string())?
         }
     };
-    let spec = match hgym::train::resolve_spec(&args.env, &config) {
-        Ok(s) => match s.downcast::<hgym::env::EnvSpec>() {
-            Some(s) => s.clone(),
-            None => {
-                return Err(UsageError(format!(
-                "`hgym run` draws lattice-Boltzmann flows; {} runs on the {} solver: use `hgym eval --policy zero|random|sine --env {}`",
-                s.id(),
-                s.solver(),
-                s.id()
-            ))
-                .into())
-            }
-        },
-        Err(hgym::train::TrainError::Input(m)) => return Err(UsageError(m).into()),
-        Err(e) => return Err(e.into()),
-    };
+    let spec = super::train::resolved(&args.env, &config)?;
     if args.steps == 0 {
         return Err(UsageError("--steps must be at least 1".into()).into());
     }
     let (pool, _) = thread_pool(args.threads)?;
     let out = args.out.join(format!(
         "{}-{}-seed{}",
-        spec.id,
+        spec.id(),
         format!("{:?}", args.policy).to_lowercase(),
         args.seed
     ));
@@ -85,9 +70,9 @@ pub fn run(args: RunArgs) -> Result<Outcome> {
     };
     eprintln!(
         "{}: starting from the developed flow (spun up once per ID and level, then cached)",
-        spec.id
+        spec.id()
     );
-    let pb = Progress::new(args.steps as u64, &spec.id);
+    let pb = Progress::new(args.steps as u64, &spec.id());
     super::train::install_interrupt();
     let summary = pool
         .install(|| {
@@ -95,7 +80,7 @@ pub fn run(args: RunArgs) -> Result<Outcome> {
                 super::train::INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst)
             })
         })
-        .with_context(|| format!("running {}", spec.id))?;
+        .with_context(|| format!("running {}", spec.id()))?;
     pb.finish_and_clear();
     println!(
         "{}: {} of {} actions, total reward {:.3}, mean C_D {:.4}{}",

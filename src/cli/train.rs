@@ -221,6 +221,15 @@ fn mapping(file: Option<&Path>) -> Result<MappingSpec> {
     Ok(file.map(load_mapping).transpose().map_err(transfer_error)?.unwrap_or_default())
 }
 
+/// The spec of `env_id` with the configuration's `[env]` overrides; its warnings go to stderr.
+pub fn resolved(env_id: &str, config: &hgym::train::config::TrainConfig) -> Result<hgym::env::Spec> {
+    let spec = resolve_spec(env_id, config).map_err(train_error)?;
+    for w in spec.warnings() {
+        eprintln!("warning: {w}");
+    }
+    Ok(spec)
+}
+
 fn train_error(e: TrainError) -> anyhow::Error {
     match e {
         TrainError::Input(m) => UsageError(m).into(),
@@ -253,7 +262,7 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
         vec![(opts, Some(ck))]
     } else {
         let env_id = args.env.clone().unwrap_or_default();
-        let spec = resolve_spec(&env_id, &config).map_err(train_error)?;
+        let spec = resolved(&env_id, &config)?;
         let source = args.init_from.as_deref().map(SourceRun::load).transpose().map_err(transfer_error)?;
         let algo_name = args
             .algo
@@ -456,7 +465,7 @@ impl EvalRun<'_> {
 
 pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
     let config = load_config(args.config.as_deref())?;
-    let spec = resolve_spec(&args.env, &config).map_err(train_error)?;
+    let spec = resolved(&args.env, &config)?;
     let named = parse_policy(&args.policy)?;
     let (mut policy, name): (Box<dyn Policy + Send>, String) = match named {
         NamedPolicy::Trained(_) if Path::new(&args.policy).join("manifest.json").exists() => {

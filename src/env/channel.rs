@@ -240,6 +240,9 @@ impl ChannelSpec {
     }
 }
 
+/// The smallest box `[Lx+, Lz+]` that sustains channel turbulence (Jimenez & Moin 1991).
+pub const MINIMAL_UNIT_PLUS: [f64; 2] = [250.0, 100.0];
+
 /// The committed statistics table.
 pub const TABLE: &str = include_str!("../../benchmarks/envs/channel.toml");
 pub const TABLE_PATH: &str = "benchmarks/envs/channel.toml";
@@ -355,6 +358,23 @@ impl FamilySpec for ChannelSpec {
     }
     fn calibrated(&self) -> bool {
         self.statistics.tau_w > 0.0
+    }
+    /// A box smaller than the minimal flow unit in viscous units (Jimenez & Moin 1991: about
+    /// `Lx+ 250-350` by `Lz+ 100`) may not sustain turbulence at this Re_tau.
+    fn warnings(&self) -> Vec<String> {
+        let (lx, lz) = (self.length[0] * self.re_tau, self.length[2] * self.re_tau);
+        if lx >= MINIMAL_UNIT_PLUS[0] && lz >= MINIMAL_UNIT_PLUS[1] {
+            return vec![];
+        }
+        vec![format!(
+            "{}: the box is Lx+ {lx:.0} by Lz+ {lz:.0} at Re_tau {}, smaller than the minimal flow unit \
+             (Jimenez & Moin 1991: Lx+ about 250-350, Lz+ about 100); turbulence may not be sustained \
+             (info `relaminarised` reports it): make length[0] >= {:.2} and length[2] >= {:.2}",
+            self.id,
+            self.re_tau,
+            MINIMAL_UNIT_PLUS[0] / self.re_tau,
+            MINIMAL_UNIT_PLUS[1] / self.re_tau
+        )]
     }
     fn hash(&self) -> String {
         ChannelSpec::hash(self)

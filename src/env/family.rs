@@ -54,6 +54,10 @@ pub trait FamilySpec: Any + Send + Sync + std::fmt::Debug {
     }
     /// Whether committed observation statistics are attached.
     fn calibrated(&self) -> bool;
+    /// Things that run but may not give what the user wants (the commands print them).
+    fn warnings(&self) -> Vec<String> {
+        vec![]
+    }
     /// SHA-256 of the spec's JSON form (keys caches and results).
     fn hash(&self) -> String;
     /// The spec as JSON (as written into manifests).

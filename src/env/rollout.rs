@@ -1,5 +1,6 @@
-//! `hgym run`: one episode of a fixed policy (zero, random, sine) on an environment, with its
-//! metrics, plots and manifest written to a result folder.
+//! `hgym run`: one episode of a fixed policy (zero, random, sine) on an environment of any
+//! family, with its metrics, plots (time series, and an image of each field of the final flow
+//! snapshot: vorticity, or a channel's wall shear stress) and manifest written to a result folder.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -7,11 +8,8 @@ use std::time::Instant;
 use hgym_agents::{Env, EnvError};
 use serde::{Deserialize, Serialize};
 
-use super::spec::EnvSpec;
-use super::LbmEnv;
+use super::family::{FlowEnv, Spec};
 use crate::data::DataError;
-use crate::env::fields::FlowFields;
-use crate::flow::vorticity_field;
 use crate::flow::Level;
 use crate::report::manifest::{manifest, Manifest};
 use crate::report::{plots, ReportError};
@@ -46,7 +44,8 @@ pub struct Metrics {
     pub reward: Vec<f64>,
     pub c_d: Vec<f64>,
     pub c_l: Vec<f64>,
-    /// Physical actuation per action, one list per actuator.
+    /// Physical actuation per action, one list per actuator the environment reports
+    /// (`actuation_j` in its info: every one in 2D, the first patch of a channel).
     pub actuation: Vec<Vec<f64>>,
 }
 
@@ -55,7 +54,8 @@ pub struct RolloutManifest {
     pub schema: String,
     pub env_id: String,
     pub spec_hash: String,
-    pub spec: EnvSpec,
+    /// The spec as `hgym envs show ID --json` prints it.
+    pub spec: serde_json::Value,
     pub level: String,
     pub seed: u64,
     pub policy: Policy,
@@ -83,24 +83,27 @@ impl Rng {
 }
 
 /// Runs one episode (at most `actions` actions) and writes `<out>/manifest.json`,
-/// `metrics.json`, `rollout.png` and `vorticity.png`.
+/// `metrics.json`, `rollout.png` and `<field>.png` for each field of the final snapshot.
 pub fn rollout(
-    spec: &EnvSpec,
+    spec: &Spec,
     opts: &RolloutOptions,
     progress: &mut dyn FnMut(usize, usize),
     stop: &dyn Fn() -> bool,
 ) -> Result<RolloutManifest, RolloutError> {
     let started = Instant::now();
-    let mut spec_run = spec.clone();
-    spec_run.episode_actions = opts.actions.max(1);
-    let mut env = LbmEnv::new(spec_run, opts.level, opts.cache.clone())?;
+    let mut length = toml::Table::new();
+    length.insert("episode_actions".into(), toml::Value::Integer(opts.actions.max(1) as i64));
+    let spec_run = spec
+        .with_overrides(&length)
+        .map_err(|e| EnvError::InvalidSpec(e.to_string()))?;
+    let mut env = spec_run.make(opts.level, opts.cache.clone())?;
     let (obs0, info0) = env.reset(opts.seed)?;
     std::fs::create_dir_all(&opts.out).map_err(|e| EnvError::Backend(format!("cannot create {}: {e}", opts.out.display())))?;
     let policy_name = format!("{:?}", opts.policy).to_lowercase();
-    let metadata = crate::env::Spec::new(spec.clone())
+    let metadata = spec
         .trajectory_manifest(opts.level, &policy_name, &[opts.seed])
         .map_err(|e| EnvError::Backend(format!("cannot describe the spec: {e}")))?;
-    let trajectory = crate::data::trajectory::TrajectoryWriter::create(&opts.out.join("trajectory.mcap"), spec.control_interval, metadata)
+    let trajectory = crate::data::trajectory::TrajectoryWriter::create(&opts.out.join("trajectory.mcap"), spec.control_interval(), metadata)
         .map_err(RolloutError::from)?;
     let mut trajectory = trajectory.with_fields(opts.fields_every);
     trajectory.reset(&obs0, &info0).map_err(RolloutError::from)?;
@@ -114,7 +117,7 @@ pub fn rollout(
         reward: vec![],
         c_d: vec![],
         c_l: vec![],
-        actuation: vec![vec![]; dim],
+        actuation: vec![],
     };
     let (mut terminated, mut truncated, mut message) = (false, false, None);
     for k in 0..opts.actions.max(1) {
@@ -138,9 +141,14 @@ pub fn rollout(
             }
         };
         m.c_d.push(force("C_D")?);
-        m.c_l.push(force("C_L")?);
+        // A flow without lift (the channel) has NaN here.
+        m.c_l.push(r.info.get("C_L").unwrap_or(f64::NAN));
+        if k == 0 {
+            let reported = (0..dim).take_while(|j| r.info.get(&format!("actuation_{j}")).is_some()).count();
+            m.actuation = vec![vec![]; reported];
+        }
         for (j, col) in m.actuation.iter_mut().enumerate() {
-            col.push(super::info_value(&r.info, &format!("actuation_{j}"))?);
+            col.push(r.info.get(&format!("actuation_{j}")).unwrap_or(f64::NAN));
         }
         progress(k + 1, opts.actions);
         if r.terminated {
@@ -161,9 +169,12 @@ pub fn rollout(
     let n = m.reward.len();
     let summary = RolloutManifest {
         schema: "hgym/rollout/v1".into(),
-        env_id: spec.id.clone(),
+        env_id: spec.id().to_string(),
         spec_hash: spec.hash(),
-        spec: spec.clone(),
+        spec: spec.to_json().map_err(|source| ReportError::Json {
+            what: "the spec".into(),
+            source,
+        })?,
         level: opts.level.name().into(),
         seed: opts.seed,
         policy: opts.policy,
@@ -176,7 +187,7 @@ pub fn rollout(
         mean_c_d: m.c_d.iter().filter(|v| v.is_finite()).sum::<f64>() / n.max(1) as f64,
         manifest: manifest(rayon::current_num_threads(), started.elapsed().as_secs_f64()),
     };
-    write(&opts.out, &summary, &m, &env)?;
+    write(&opts.out, &summary, &m, &mut env)?;
     Ok(summary)
 }
 
@@ -191,7 +202,7 @@ pub enum RolloutError {
     Report(#[from] ReportError),
 }
 
-fn write(dir: &Path, summary: &RolloutManifest, m: &Metrics, env: &LbmEnv) -> Result<(), ReportError> {
+fn write(dir: &Path, summary: &RolloutManifest, m: &Metrics, env: &mut Box<dyn FlowEnv>) -> Result<(), ReportError> {
     std::fs::create_dir_all(dir).map_err(ReportError::io(dir))?;
     let json = |what: &str, text: serde_json::Result<String>| {
         text.map_err(|source| ReportError::Json {
@@ -231,12 +242,15 @@ fn write(dir: &Path, summary: &RolloutManifest, m: &Metrics, env: &LbmEnv) -> Re
         summary.env_id, summary.level, summary.policy, summary.seed
     );
     plots::time_series(&dir.join("rollout.png"), &title, &m.t, &panels, None)?;
-    let d = &summary.spec.domain;
-    let v = vorticity_field(env.solver(), env.units(), [d.x[0], d.x[1], d.y[0], d.y[1]]);
-    crate::report::plots::field_png(
-        &v,
-        &dir.join("vorticity.png"),
-        &format!("{}: vorticity w L/U at the end", summary.env_id),
-    )?;
+    let snapshot = env.snapshot();
+    for (name, values) in &snapshot.fields {
+        let field = crate::flow::Field {
+            nx: snapshot.nx,
+            ny: snapshot.ny,
+            extent: snapshot.extent,
+            values: values.clone(),
+        };
+        plots::field_png(&field, &dir.join(format!("{name}.png")), &format!("{}: {name} at the end", summary.env_id))?;
+    }
     Ok(())
 }
