@@ -14,6 +14,8 @@
 //! - Reward: `1 - tau_w / tau_w,ref` with `tau_w` the mean wall shear stress of the actuated
 //!   walls over the interval and `tau_w,ref` the uncontrolled one (calibrated). `info` carries
 //!   `C_f = 2 tau_w` also as `C_D`, the drag coefficient `hgym eval` compares.
+//! - Agents (multi-agent training, `hgym_agents::multi`): one per patch, seeing the patches
+//!   around its own and rewarded by its own patch's wall shear stress ([`ChannelAgents`]).
 //! - `u_tau` is the nominal `Re_tau nu / h` until the ID is calibrated (`hgym envs calibrate`),
 //!   then the measured uncontrolled one.
 //!
