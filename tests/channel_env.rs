@@ -190,7 +190,17 @@ fn run_draws_the_wall_shear_stress() {
     let cfg = tmp.path().join("short.toml");
     std::fs::write(&cfg, "[env]\nspin_up = 4.0\nlength = [1.2, 2.0, 0.4]\n").unwrap();
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_hgym"))
-        .args(["run", "--env", "TCFMini_3D_Retau180", "--res", "coarse", "--steps", "3", "--policy", "random"])
+        .args([
+            "run",
+            "--env",
+            "TCFMini_3D_Retau180",
+            "--res",
+            "coarse",
+            "--steps",
+            "3",
+            "--policy",
+            "random",
+        ])
         .arg("--config")
         .arg(&cfg)
         .arg("--out")
@@ -200,10 +210,20 @@ fn run_draws_the_wall_shear_stress() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{stderr}");
-    assert!(stderr.contains("warning: TCFMini_3D_Retau180: the box is Lx+ 216 by Lz+ 72"), "{stderr}");
+    assert!(
+        stderr.contains("warning: TCFMini_3D_Retau180: the box is Lx+ 216 by Lz+ 72"),
+        "{stderr}"
+    );
     assert!(stderr.contains("length[0] >= 1.39"), "{stderr}");
     let dir = tmp.path().join("TCFMini_3D_Retau180-random-seed0");
-    for f in ["manifest.json", "metrics.json", "rollout.png", "tau_w_excess.png", "u_sensing.png", "trajectory.mcap"] {
+    for f in [
+        "manifest.json",
+        "metrics.json",
+        "rollout.png",
+        "tau_w_excess.png",
+        "u_sensing.png",
+        "trajectory.mcap",
+    ] {
         assert!(dir.join(f).exists(), "{f} missing");
     }
     let m: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();

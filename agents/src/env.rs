@@ -121,82 +121,49 @@ pub trait DifferentiableEnv: Env {
     fn reward_action_gradients(&mut self, k: usize) -> Result<Vec<Vec<f64>>, EnvError>;
 }
 
-impl<E: Env + ?Sized> Env for Box<E> {
-    fn observation_space(&self) -> BoxSpace {
-        (**self).observation_space()
-    }
+/// The contract through a box or a mutable reference to an environment.
+macro_rules! forward_env {
+    ($($ptr:ty),*) => {$(
+        impl<E: Env + ?Sized> Env for $ptr {
+            fn observation_space(&self) -> BoxSpace {
+                (**self).observation_space()
+            }
 
-    fn action_space(&self) -> BoxSpace {
-        (**self).action_space()
-    }
+            fn action_space(&self) -> BoxSpace {
+                (**self).action_space()
+            }
 
-    fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
-        (**self).reset(seed)
-    }
+            fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
+                (**self).reset(seed)
+            }
 
-    fn step(&mut self, action: &[f64]) -> Result<StepResult, EnvError> {
-        (**self).step(action)
-    }
+            fn step(&mut self, action: &[f64]) -> Result<StepResult, EnvError> {
+                (**self).step(action)
+            }
 
-    fn agents(&self) -> Option<Agents> {
-        (**self).agents()
-    }
+            fn agents(&self) -> Option<Agents> {
+                (**self).agents()
+            }
 
-    fn agent_rewards(&self) -> Vec<f64> {
-        (**self).agent_rewards()
-    }
+            fn agent_rewards(&self) -> Vec<f64> {
+                (**self).agent_rewards()
+            }
 
-    fn submit(&mut self, action: &[f64]) -> Result<(), EnvError> {
-        (**self).submit(action)
-    }
+            fn submit(&mut self, action: &[f64]) -> Result<(), EnvError> {
+                (**self).submit(action)
+            }
 
-    fn submit_reset(&mut self, seed: u64) -> Result<(), EnvError> {
-        (**self).submit_reset(seed)
-    }
+            fn submit_reset(&mut self, seed: u64) -> Result<(), EnvError> {
+                (**self).submit_reset(seed)
+            }
+        }
+
+        impl<E: DifferentiableEnv + ?Sized> DifferentiableEnv for $ptr {
+            fn reward_action_gradients(&mut self, k: usize) -> Result<Vec<Vec<f64>>, EnvError> {
+                (**self).reward_action_gradients(k)
+            }
+        }
+    )*};
 }
 
-impl<E: DifferentiableEnv + ?Sized> DifferentiableEnv for Box<E> {
-    fn reward_action_gradients(&mut self, k: usize) -> Result<Vec<Vec<f64>>, EnvError> {
-        (**self).reward_action_gradients(k)
-    }
-}
-
-impl<E: Env + ?Sized> Env for &mut E {
-    fn observation_space(&self) -> BoxSpace {
-        (**self).observation_space()
-    }
-
-    fn action_space(&self) -> BoxSpace {
-        (**self).action_space()
-    }
-
-    fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
-        (**self).reset(seed)
-    }
-
-    fn step(&mut self, action: &[f64]) -> Result<StepResult, EnvError> {
-        (**self).step(action)
-    }
-
-    fn agents(&self) -> Option<Agents> {
-        (**self).agents()
-    }
-
-    fn agent_rewards(&self) -> Vec<f64> {
-        (**self).agent_rewards()
-    }
-
-    fn submit(&mut self, action: &[f64]) -> Result<(), EnvError> {
-        (**self).submit(action)
-    }
-
-    fn submit_reset(&mut self, seed: u64) -> Result<(), EnvError> {
-        (**self).submit_reset(seed)
-    }
-}
-
-impl<E: DifferentiableEnv + ?Sized> DifferentiableEnv for &mut E {
-    fn reward_action_gradients(&mut self, k: usize) -> Result<Vec<Vec<f64>>, EnvError> {
-        (**self).reward_action_gradients(k)
-    }
-}
+forward_env!(Box<E>, &mut E);

@@ -165,31 +165,29 @@ pub fn run(cmd: BenchCommand) -> Result<Outcome> {
         } => run_bench_envs(json, actions, quick, &family),
         BenchCommand::Agents(args) => run_bench_agents(args),
         BenchCommand::Python { json, quick, peer } => run_bench_python(json, quick, peer),
-        BenchCommand::Kolmogorov(PeerBenchArgs {
-            json,
-            quick,
-            threads,
-            peer,
-        }) => {
-            let (pool, n) = thread_pool(threads)?;
-            let mut peer = start_peer(peer, hgym::bench::peer::HYDROGYM_KOLMOGOROV, n)?;
-            let b = pool.install(|| hgym::bench::kolmogorov::bench_kolmogorov(quick, peer.as_mut()))?;
-            print_report(json, &b, &hgym::bench::kolmogorov::table(&b))?;
-            Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
-        }
-        BenchCommand::Channel(PeerBenchArgs {
-            json,
-            quick,
-            threads,
-            peer,
-        }) => {
-            let (pool, n) = thread_pool(threads)?;
-            let mut peer = start_peer(peer, hgym::bench::peer::HYDROGYM_CHANNEL, n)?;
-            let b = pool.install(|| hgym::bench::channel::bench_channel(quick, n, peer.as_mut()))?;
-            print_report(json, &b, &hgym::bench::channel::table(&b))?;
-            Ok(if b.pass || quick { Outcome::Ok } else { Outcome::CheckFailed })
-        }
+        BenchCommand::Kolmogorov(args) => run_peer_bench(args, hgym::bench::peer::HYDROGYM_KOLMOGOROV, |quick, _, peer| {
+            let b = hgym::bench::kolmogorov::bench_kolmogorov(quick, peer)?;
+            Ok((hgym::bench::kolmogorov::table(&b), b.pass, serde_json::to_value(b)?))
+        }),
+        BenchCommand::Channel(args) => run_peer_bench(args, hgym::bench::peer::HYDROGYM_CHANNEL, |quick, threads, peer| {
+            let b = hgym::bench::channel::bench_channel(quick, threads, peer)?;
+            Ok((hgym::bench::channel::table(&b), b.pass, serde_json::to_value(b)?))
+        }),
     }
+}
+
+/// A benchmark with an optional peer: `bench(quick, threads, peer)` gives its table, whether it
+/// passed and its JSON report. Exit 1 when it falls short (not judged with --quick).
+fn run_peer_bench(
+    args: PeerBenchArgs,
+    script: (&str, &str),
+    bench: impl FnOnce(bool, usize, Option<&mut Peer>) -> Result<(String, bool, serde_json::Value)> + Send,
+) -> Result<Outcome> {
+    let (pool, n) = thread_pool(args.threads)?;
+    let mut peer = start_peer(args.peer, script, n)?;
+    let (table, pass, report) = pool.install(|| bench(args.quick, n, peer.as_mut()))?;
+    print_report(args.json, &report, &table)?;
+    Ok(if pass || args.quick { Outcome::Ok } else { Outcome::CheckFailed })
 }
 
 /// A benchmark's report as pretty JSON (`--json`) or as its table.

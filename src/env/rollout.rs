@@ -93,9 +93,7 @@ pub fn rollout(
     let started = Instant::now();
     let mut length = toml::Table::new();
     length.insert("episode_actions".into(), toml::Value::Integer(opts.actions.max(1) as i64));
-    let spec_run = spec
-        .with_overrides(&length)
-        .map_err(|e| EnvError::InvalidSpec(e.to_string()))?;
+    let spec_run = spec.with_overrides(&length).map_err(|e| EnvError::InvalidSpec(e.to_string()))?;
     let mut env = spec_run.make(opts.level, opts.cache.clone())?;
     let (obs0, info0) = env.reset(opts.seed)?;
     std::fs::create_dir_all(&opts.out).map_err(|e| EnvError::Backend(format!("cannot create {}: {e}", opts.out.display())))?;
@@ -103,8 +101,9 @@ pub fn rollout(
     let metadata = spec
         .trajectory_manifest(opts.level, &policy_name, &[opts.seed])
         .map_err(|e| EnvError::Backend(format!("cannot describe the spec: {e}")))?;
-    let trajectory = crate::data::trajectory::TrajectoryWriter::create(&opts.out.join("trajectory.mcap"), spec.control_interval(), metadata)
-        .map_err(RolloutError::from)?;
+    let trajectory =
+        crate::data::trajectory::TrajectoryWriter::create(&opts.out.join("trajectory.mcap"), spec.control_interval(), metadata)
+            .map_err(RolloutError::from)?;
     let mut trajectory = trajectory.with_fields(opts.fields_every);
     trajectory.reset(&obs0, &info0).map_err(RolloutError::from)?;
     if trajectory.wants_field() {
@@ -250,7 +249,11 @@ fn write(dir: &Path, summary: &RolloutManifest, m: &Metrics, env: &mut Box<dyn F
             extent: snapshot.extent,
             values: values.clone(),
         };
-        plots::field_png(&field, &dir.join(format!("{name}.png")), &format!("{}: {name} at the end", summary.env_id))?;
+        plots::field_png(
+            &field,
+            &dir.join(format!("{name}.png")),
+            &format!("{}: {name} at the end", summary.env_id),
+        )?;
     }
     Ok(())
 }
