@@ -24,6 +24,8 @@ pub struct DdpgConfig {
     pub n_envs: usize,
     /// As TD3's.
     pub gradient_steps: Option<usize>,
+    /// As TD3's.
+    pub action_l2: f64,
 }
 
 impl Default for DdpgConfig {
@@ -42,6 +44,7 @@ impl Default for DdpgConfig {
             ou_sigma: 0.2,
             n_envs: t.n_envs,
             gradient_steps: t.gradient_steps,
+            action_l2: t.action_l2,
         }
     }
 }
@@ -65,6 +68,7 @@ pub fn ddpg(cfg: &DdpgConfig, obs_dim: usize, act_dim: usize, seed: u64) -> Td3 
         target_noise_clip: 0.0,
         n_envs: cfg.n_envs,
         gradient_steps: cfg.gradient_steps,
+        action_l2: cfg.action_l2,
     };
     Td3::new("ddpg", t, obs_dim, act_dim, seed)
 }

@@ -50,6 +50,12 @@ pub struct Td3Config {
     /// transition (SB3's `gradient_steps = -1`). Multi-agent runs collect one transition per
     /// agent per step and set a number here.
     pub gradient_steps: Option<usize>,
+    /// Weight `lambda` of the actor's action penalty: the actor minimises
+    /// `-Q_1(s, mu(s)) + lambda |mu(s)|^2` (OpenAI Baselines' `action_l2`, Andrychowicz et al.
+    /// 2017). 0 is TD3 itself. It keeps actions that no reward distinguishes (such as the common
+    /// part of zero-net-mass-flux actuators, which the flow never sees) from drifting into the
+    /// saturation of the actor's tanh, where its gradient vanishes.
+    pub action_l2: f64,
 }
 
 impl Default for Td3Config {
@@ -71,6 +77,7 @@ impl Default for Td3Config {
             target_noise_clip: 0.5,
             n_envs: 2,
             gradient_steps: None,
+            action_l2: 0.0,
         }
     }
 }
@@ -316,7 +323,8 @@ impl Td3 {
             });
         self.updates += 1;
 
-        // Actor: maximise Q_1(s, mu(s)) every `policy_delay` updates, then move the targets.
+        // Actor: maximise Q_1(s, mu(s)) - lambda |mu(s)|^2 every `policy_delay` updates, then
+        // move the targets.
         if self.updates.is_multiple_of(self.cfg.policy_delay.max(1) as u64) {
             let mu = self.actor.forward(&s.batch.obs, b, &mut s.actor_tape);
             concat_rows(&s.batch.obs, mu, o, a, &mut s.sa);
@@ -329,6 +337,10 @@ impl Td3 {
             s.da.clear();
             for row in s.dsa.chunks_exact(o + a) {
                 s.da.extend_from_slice(&row[o..]);
+            }
+            if self.cfg.action_l2 > 0.0 {
+                let w = (2.0 * self.cfg.action_l2 / b as f64) as f32;
+                s.da.iter_mut().zip(s.actor_tape.output()).for_each(|(d, m)| *d += w * m);
             }
             s.actor_grad.iter_mut().for_each(|g| *g = 0.0);
             self.actor.backward(&mut s.actor_tape, &s.da, Some(&mut s.actor_grad), None);

@@ -184,3 +184,74 @@ fn resume_is_bitwise_identical() {
         assert_eq!(resumed.to_bytes().unwrap(), whole.to_bytes().unwrap(), "{algo}");
     }
 }
+
+/// An environment whose reward no action changes (a random observation, reward 0).
+#[derive(Clone)]
+struct Indifferent {
+    rng: hgym_agents::rng::Rng,
+    k: usize,
+}
+
+impl hgym_agents::Env for Indifferent {
+    fn observation_space(&self) -> hgym_agents::BoxSpace {
+        hgym_agents::BoxSpace::uniform(2, -1.0, 1.0)
+    }
+    fn action_space(&self) -> hgym_agents::BoxSpace {
+        hgym_agents::BoxSpace::unit(1)
+    }
+    fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, hgym_agents::Info), hgym_agents::EnvError> {
+        self.rng = hgym_agents::rng::Rng::seed(seed);
+        self.k = 0;
+        Ok((vec![self.rng.uniform(), self.rng.uniform()], hgym_agents::Info::default()))
+    }
+    fn step(&mut self, _a: &[f64]) -> Result<hgym_agents::StepResult, hgym_agents::EnvError> {
+        self.k += 1;
+        Ok(hgym_agents::StepResult {
+            obs: vec![self.rng.uniform(), self.rng.uniform()],
+            reward: 0.0,
+            terminated: false,
+            truncated: self.k >= 50,
+            info: hgym_agents::Info::default(),
+        })
+    }
+}
+
+impl hgym_agents::DifferentiableEnv for Indifferent {
+    fn reward_action_gradients(&mut self, _k: usize) -> Result<Vec<Vec<f64>>, hgym_agents::EnvError> {
+        Err(hgym_agents::EnvError::Backend("none".into()))
+    }
+}
+
+/// TD3's action penalty (`action_l2`) settles actions that no reward distinguishes at zero;
+/// without it they wander (the critic's noise is all the actor sees).
+#[test]
+fn the_action_penalty_settles_indifferent_actions_at_zero() {
+    let largest_action = |l2: f64| {
+        let mut cfg = small();
+        let mut td3 = cfg.0["td3"].clone();
+        td3["action_l2"] = serde_json::json!(l2);
+        td3["learning_starts"] = serde_json::json!(100);
+        cfg.0.insert("td3".into(), td3);
+        let mut learner = algorithm("td3").unwrap().learner(&cfg, 2, 1, 1).unwrap();
+        let env = Indifferent {
+            rng: hgym_agents::rng::Rng::seed(0),
+            k: 0,
+        };
+        let mut envs = vec![env.clone(), env];
+        for _ in 0..30 {
+            learner.round_on(&mut envs).unwrap();
+        }
+        let mut policy = learner.policy();
+        let mut worst: f64 = 0.0;
+        for i in 0..50 {
+            let obs = [(i % 7) as f64 / 3.5 - 1.0, (i % 5) as f64 / 2.5 - 1.0];
+            let mut a = [0.0];
+            policy.act(&obs, &hgym_agents::Info::default(), &mut a);
+            worst = worst.max(a[0].abs());
+        }
+        worst
+    };
+    let (free, held) = (largest_action(0.0), largest_action(1.0));
+    println!("largest |action| without the penalty {free:.3}, with it {held:.3}");
+    assert!(held < 0.1 && held < 0.25 * free, "largest |action| {held} with the penalty, {free} without");
+}

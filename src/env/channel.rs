@@ -15,7 +15,7 @@
 //!   walls over the interval and `tau_w,ref` the uncontrolled one (calibrated). `info` carries
 //!   `C_f = 2 tau_w` also as `C_D`, the drag coefficient `hgym eval` compares.
 //! - Agents (multi-agent training, `hgym_agents::multi`): one per patch, seeing the patches
-//!   around its own and rewarded by its own patch's wall shear stress ([`ChannelAgents`]).
+//!   around its own, rewarded by the global reward ([`ChannelAgents`]).
 //! - `u_tau` is the nominal `Re_tau nu / h` until the ID is calibrated (`hgym envs calibrate`),
 //!   then the measured uncontrolled one.
 //!
@@ -87,8 +87,12 @@ pub struct ChannelSpec {
 
 /// One agent per actuator patch (`hgym train` trains one policy they share, `hgym_agents::multi`).
 /// An agent sees `u'` and `v'` above the `(2 window + 1)^2` patches centred on its own, on its
-/// own wall (periodic in x and z), rows in z, x fastest, and learns from the global reward or
-/// its own `1 - tau_w,patch / tau_w,ref` (the patches tile the wall without overlap).
+/// own wall (periodic in x and z), rows in z, x fastest, and learns from the global reward (the
+/// paper's: the wall shear stress is a global invariant of the developed channel) or its own
+/// `1 - tau_w,patch / tau_w,ref` (the patches tile the wall without overlap). The local reward
+/// pays each agent for blowing, which lowers the shear under its own patch while the
+/// zero-net-mass-flux suction that balances it raises the shear under the others: every agent
+/// learns to blow, and the mean removal leaves no actuation at all.
 #[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ChannelAgents {
@@ -100,7 +104,7 @@ impl Default for ChannelAgents {
     fn default() -> Self {
         ChannelAgents {
             window: 1,
-            reward: AgentReward::Local,
+            reward: AgentReward::Global,
         }
     }
 }
