@@ -196,6 +196,31 @@ impl Env {
             .map_err(|e| PyRuntimeError::new_err(e.to_string()))
     }
 
+    /// How the flow splits into agents (`hgym_agents::multi`), or `None`: a dict with `obs` and
+    /// `act` (per agent, the global indices of its observation and of its actions) and `reward`
+    /// (`"global"` or `"local"`).
+    fn agents<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(a) = self.env()?.agents() else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        d.set_item("obs", a.obs)?;
+        d.set_item("act", a.act)?;
+        d.set_item(
+            "reward",
+            match a.reward {
+                hgym_agents::multi::AgentReward::Global => "global",
+                hgym_agents::multi::AgentReward::Local => "local",
+            },
+        )?;
+        Ok(Some(d))
+    }
+
+    /// The last step's reward of each agent (local rewards).
+    fn agent_rewards(&self) -> PyResult<Vec<f64>> {
+        Ok(self.env()?.agent_rewards())
+    }
+
     /// For the last `k` steps, the gradient of their summed reward with respect to each step's
     /// action (a `k x act_dim` float64 array; one adjoint sweep). Differentiable flows only.
     fn reward_action_gradients<'py>(&self, py: Python<'py>, k: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
