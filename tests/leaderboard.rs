@@ -71,6 +71,27 @@ fn leaderboard_rebuilds_the_committed_one_from_the_committed_results() {
     assert!(stale("2560ad80") && !stale("777475c1") && !stale("a42c4a1a"));
     let heading = md.find("# Stale").expect("a stale section");
     assert!(md.find("spec 2560ad80").unwrap() > heading && md.find("spec 777475c1").unwrap() < heading);
+    // Every entry says how to make it again; a training run's command takes the run's own
+    // configuration from its folder (`--config RUN_DIR`), and each entry links its folders.
+    let td3 = "hgym train --env Cylinder_2D_Re100 --algo td3 --res coarse --seeds 0..=2 \
+               --config results/train/Cylinder_2D_Re100-td3-coarse/seed0";
+    assert!(entries
+        .iter()
+        .all(|e| e["reproduce"].as_str().is_some_and(|c| c.starts_with("hgym "))));
+    assert!(entries.iter().any(|e| e["reproduce"] == td3), "no entry reproduced by {td3}");
+    assert!(md.contains(&format!("`{td3}`")) && md.contains("[seed2](train/Cylinder_2D_Re100-td3-coarse/seed2)"));
+    let o = Command::new(env!("CARGO_BIN_EXE_hgym"))
+        .current_dir(root)
+        .args([
+            "train",
+            "--print-config",
+            "--config",
+            "results/train/Cylinder_2D_Re100-td3-coarse/seed0",
+        ])
+        .output()
+        .unwrap();
+    let printed = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success() && printed.contains("steps = 30000"), "{printed}");
 }
 
 /// A folder whose metrics.json is damaged is listed as a problem row (JSON, markdown, a warning

@@ -253,5 +253,8 @@ fn the_action_penalty_settles_indifferent_actions_at_zero() {
     };
     let (free, held) = (largest_action(0.0), largest_action(1.0));
     println!("largest |action| without the penalty {free:.3}, with it {held:.3}");
-    assert!(held < 0.1 && held < 0.25 * free, "largest |action| {held} with the penalty, {free} without");
+    assert!(
+        held < 0.1 && held < 0.25 * free,
+        "largest |action| {held} with the penalty, {free} without"
+    );
 }

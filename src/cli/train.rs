@@ -48,7 +48,8 @@ pub struct TrainArgs {
     /// Resolution level. Training defaults to coarse: the default level costs ~30x more per action.
     #[arg(long = "res", value_enum, default_value_t = Level::Coarse)]
     level: Level,
-    /// TOML file overriding the defaults: [train], [ppo], [ddpg], [td3], [env] (see --print-config).
+    /// TOML file overriding the defaults: [train], [ppo], [ddpg], [td3], [env] (see --print-config);
+    /// or a training result folder, to train with the configuration it was made with.
     #[arg(long)]
     config: Option<PathBuf>,
     /// Where result folders go: <out>/<ID>-<algo>-<level>/seed<S>/ (fine-tuning: <ID>-<algo>-<level>-from-<SOURCE>-seed<S>/).

@@ -37,6 +37,8 @@ pub struct Entry {
     pub wall_time_s: Option<f64>,
     pub code_versions: Vec<String>,
     pub runs: Vec<PathBuf>,
+    /// The command that makes these runs again (from the repository's root).
+    pub reproduce: String,
     /// The spec hash is not the current one for these runs (see the module's doc).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub stale: bool,
@@ -70,6 +72,11 @@ struct Run {
     version: Option<String>,
     /// The run's training configuration (its `[env]` overrides change the spec).
     config_toml: Option<String>,
+    /// A training run's seed and the run it was fine-tuned from; an evaluation's first seed
+    /// and episodes.
+    seed: Option<u64>,
+    init_from: Option<String>,
+    episodes: Option<u64>,
     dir: PathBuf,
 }
 
@@ -148,6 +155,9 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Probl
                 .map(|c| format!("{} ({c})", manifest["manifest"]["code_version"].as_str().unwrap_or("hgym")))
                 .or_else(|| manifest["manifest"]["code_version"].as_str().map(|s| s.to_string())),
             config_toml: manifest["config_toml"].as_str().map(str::to_string),
+            seed: manifest["seed"].as_u64().or(manifest["eval_seed"].as_u64()),
+            init_from: manifest["init_from"]["dir"].as_str().map(str::to_string),
+            episodes: manifest["episodes"].as_u64(),
             dir: shown,
             report,
         });
@@ -177,6 +187,7 @@ pub fn build(results: &Path, env: Option<&str>, current: CurrentHash) -> Leaderb
                 .iter()
                 .any(|r| current(&env_id, r.config_toml.as_deref()).as_deref() != Some(spec_hash.as_str()));
             Entry {
+                reproduce: reproduce(&env_id, &level, &policy, &runs),
                 stale,
                 kind: runs[0].kind.to_string(),
                 seeds: runs.len(),
@@ -213,6 +224,40 @@ pub fn build(results: &Path, env: Option<&str>, current: CurrentHash) -> Leaderb
     }
 }
 
+/// `hgym train` with the first run's configuration (`--config RUN_DIR`) over the entry's seeds,
+/// or `hgym eval` of the baseline with its seeds.
+fn reproduce(env: &str, level: &str, policy: &str, runs: &[Run]) -> String {
+    let first = &runs[0];
+    if first.kind == "baseline" {
+        return format!(
+            "hgym eval --env {env} --policy {policy} --res {level} --episodes {} --eval-seed {} --out results/eval",
+            first.episodes.unwrap_or(first.report.episodes.len() as u64),
+            first.seed.unwrap_or(first.report.episodes.first().map_or(0, |e| e.seed)),
+        );
+    }
+    let mut seeds: Vec<u64> = runs.iter().filter_map(|r| r.seed).collect();
+    seeds.sort();
+    let contiguous = seeds.windows(2).all(|w| w[1] == w[0] + 1);
+    let seeds = match (seeds.first(), seeds.last()) {
+        (Some(a), Some(b)) if contiguous && b > a => format!("{a}..={b}"),
+        _ => seeds.iter().map(u64::to_string).collect::<Vec<_>>().join(","),
+    };
+    let init = first.init_from.as_ref().map(|d| format!(" --init-from {d}")).unwrap_or_default();
+    format!(
+        "hgym train --env {env} --algo {policy} --res {level} --seeds {seeds} --config {}{init}",
+        first.dir.display()
+    )
+}
+
+/// `results/train/X/seed0` as a link from `results/LEADERBOARD.md`.
+fn link(dir: &Path) -> String {
+    let rel = dir.strip_prefix("results").unwrap_or(dir);
+    let name = dir
+        .file_name()
+        .map_or_else(|| dir.display().to_string(), |n| n.to_string_lossy().into_owned());
+    format!("[{name}]({})", rel.display())
+}
+
 fn fmt_stat(s: &Stat, unit: &str) -> String {
     if s.mean.is_finite() {
         format!("{:+.2}{unit} ± {:.2}", s.mean, s.std)
@@ -231,6 +276,7 @@ pub fn markdown(lb: &Leaderboard) -> String {
     let mut last = (String::new(), String::new(), String::new());
     let mut rank = 0;
     let mut stale_heading = false;
+    let mut commands = String::new();
     for e in &lb.entries {
         if e.stale && !stale_heading {
             stale_heading = true;
@@ -239,6 +285,7 @@ pub fn markdown(lb: &Leaderboard) -> String {
         }
         let group = (e.env_id.clone(), e.level.clone(), e.spec_hash.clone());
         if group != last {
+            s += &std::mem::take(&mut commands);
             last = group;
             rank = 0;
             let short = &e.spec_hash[..e.spec_hash.len().min(8)];
@@ -259,7 +306,13 @@ pub fn markdown(lb: &Leaderboard) -> String {
             e.wall_time_s.map(|v| format!("{v:.0} s")).unwrap_or_else(|| "–".into()),
             e.code_versions.join(", ")
         );
+        if commands.is_empty() {
+            commands += "\nReproduce (from the repository's root), and the result folders:\n\n";
+        }
+        let links: Vec<String> = e.runs.iter().map(|d| link(d)).collect();
+        commands += &format!("- {}: `{}` ({})\n", e.policy, e.reproduce, links.join(", "));
     }
+    s += &commands;
     if !lb.problems.is_empty() {
         s += "\n## Folders that could not be read\n\n| folder | problem |\n|---|---|\n";
         for p in &lb.problems {

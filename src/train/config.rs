@@ -119,13 +119,31 @@ impl TrainConfig {
         Ok(c)
     }
 
-    /// Reads and parses the file `path`.
+    /// Reads and parses the file `path`; a training result folder gives the configuration its
+    /// run was made with (its manifest's `config_toml`), so `--config RUN_DIR` repeats a run.
     pub fn load(path: &std::path::Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
-            path: path.to_path_buf(),
+        let file = if path.is_dir() {
+            path.join("manifest.json")
+        } else {
+            path.to_path_buf()
+        };
+        let text = std::fs::read_to_string(&file).map_err(|source| ConfigError::Read {
+            path: file.clone(),
             source,
         })?;
-        Self::parse(&text, &path.display().to_string())
+        if !path.is_dir() {
+            return Self::parse(&text, &path.display().to_string());
+        }
+        let origin = format!("{} (its config_toml)", file.display());
+        let invalid = |message: String| ConfigError::Invalid {
+            origin: origin.clone(),
+            message,
+        };
+        let manifest: serde_json::Value = serde_json::from_str(&text).map_err(|e| invalid(format!("not JSON: {e}")))?;
+        let toml = manifest["config_toml"]
+            .as_str()
+            .ok_or_else(|| invalid("no config_toml: not a training result folder".into()))?;
+        Self::parse(toml, &origin)
     }
 
     pub fn to_toml(&self) -> String {
