@@ -126,6 +126,10 @@ pub struct Td3 {
     pub samples: u64,
     pub updates: u64,
     pub round: u64,
+    /// The actor is a trained policy (`init_actor`): it acts, with its exploration noise, from
+    /// the first transition instead of the uniformly random warm-up, which would fill the
+    /// buffer with what a fine-tuned run has no use for and teach the critics that policy.
+    warm: bool,
     #[serde(skip)]
     scratch: Scratch,
 }
@@ -178,6 +182,7 @@ impl Td3 {
             ou,
             samples: 0,
             updates: 0,
+            warm: false,
             round: 0,
             cfg,
             scratch: Scratch::default(),
@@ -189,10 +194,10 @@ impl Td3 {
         ActorPolicy::new(&self.name, self.actor.clone(), None, 10.0)
     }
 
-    /// Exploratory action for environment `env`: random before `learning_starts`, then
-    /// `clip(mu(s) + noise)`.
+    /// Exploratory action for environment `env`: random before `learning_starts` (unless the
+    /// actor is a trained policy), then `clip(mu(s) + noise)`.
     fn explore(&mut self, env: usize, obs: &[f64], action: &mut [f64]) {
-        if (self.samples as usize) < self.cfg.learning_starts {
+        if !self.warm && (self.samples as usize) < self.cfg.learning_starts {
             action.iter_mut().for_each(|a| *a = 2.0 * self.rng.uniform() - 1.0);
             return;
         }
@@ -419,6 +424,7 @@ impl Learner for Td3 {
         }
         self.actor = policy.net.clone();
         self.actor_target = policy.net.clone();
+        self.warm = true;
         Ok(())
     }
 

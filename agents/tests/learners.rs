@@ -258,3 +258,28 @@ fn the_action_penalty_settles_indifferent_actions_at_zero() {
         "largest |action| {held} with the penalty, {free} without"
     );
 }
+
+/// A TD3 learner started from a trained actor (`--init-from`) acts with it, plus its exploration
+/// noise, from the first transition; a fresh one acts at random until `learning_starts`.
+#[test]
+fn a_fine_tuned_td3_skips_the_random_warm_up() {
+    let (zero, pd) = references();
+    let policy = train("td3", 60, 7).policy();
+    let first_round = |init: bool| {
+        let mut learner = new_learner("td3", 8);
+        if init {
+            learner.init_actor(&policy).unwrap();
+        }
+        let mut envs = vec![Oscillator::default(); n_envs("td3")];
+        let stats = learner.round_on(&mut envs).unwrap();
+        assert!(learner.samples() < 400, "the round must lie inside the warm-up");
+        stats.iter().map(|s| s.ret).sum::<f64>() / stats.len() as f64
+    };
+    let (fresh, tuned) = (first_round(false), first_round(true));
+    let half = zero + 0.5 * (pd - zero);
+    println!("first round: fresh {fresh:.2}, from the trained actor {tuned:.2} (zero {zero:.2}, PD {pd:.2})");
+    assert!(
+        tuned > half && fresh < half,
+        "fresh {fresh:.2}, fine-tuned {tuned:.2}, half-way {half:.2}"
+    );
+}

@@ -10,8 +10,9 @@ use serde::{Deserialize, Serialize};
 use super::curve::CurveRow;
 use crate::flow::Level;
 
-/// 2: the algorithm by name and its learner's own bytes (1 held an enum over the learners).
-pub const FORMAT: u32 = 2;
+/// 3: TD3/DDPG learners with `gradient_steps`, `action_l2` and the warm start of a fine-tuned
+/// actor; 2: the algorithm by name and its learner's own bytes (1 held an enum over the learners).
+pub const FORMAT: u32 = 3;
 pub const FILE: &str = "checkpoint.bin";
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
