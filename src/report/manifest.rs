@@ -11,7 +11,7 @@ pub struct Machine {
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Manifest {
-    /// `hgym <version>`, plus the git commit when run from a checkout.
+    /// `hgym <version>`; `git_commit` is the commit the binary was built from.
     pub code_version: String,
     pub git_commit: Option<String>,
     pub machine: Machine,
@@ -40,18 +40,11 @@ pub fn machine() -> Machine {
     }
 }
 
-/// The commit of the checkout the binary runs in, if git can tell.
+/// The commit the binary was built from (`-dirty` when tracked files had uncommitted changes;
+/// `None` when it was not built in a git checkout), whatever directory it runs in.
 pub fn git_commit() -> Option<String> {
-    let out = std::process::Command::new("git")
-        .args(["rev-parse", "--short=12", "HEAD"])
-        .stderr(std::process::Stdio::null())
-        .output()
-        .ok()?;
-    if !out.status.success() {
-        return None;
-    }
-    let s = String::from_utf8(out.stdout).ok()?.trim().to_string();
-    (!s.is_empty()).then_some(s)
+    let c = env!("HGYM_GIT_COMMIT");
+    (!c.is_empty()).then(|| c.to_string())
 }
 
 pub fn manifest(threads: usize, wall_time_s: f64) -> Manifest {
