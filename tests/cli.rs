@@ -499,6 +499,25 @@ fn bench_quick_reports_mlups_and_roofline_fraction() {
     assert_eq!(v["bytes_per_cell"], 72);
 }
 
+/// `hgym bench channel --quick`: steps/s and simulated t+ per second of the minimal and the full
+/// channel, 1 and 2 threads, consistent with each other; no peer, so nothing is judged.
+#[test]
+fn bench_channel_quick_reports_simulated_time_per_second() {
+    let o = hgym(&["bench", "channel", "--quick", "--json", "--threads", "2"]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 4, "{out}");
+    for r in rows {
+        let f = |k: &str| r[k].as_f64().unwrap();
+        assert!(f("steps_per_s") > 0.0);
+        assert!((f("t_plus_per_s") - f("steps_per_s") * f("dt_plus")).abs() < 1e-9 * f("t_plus_per_s"));
+        assert!((f("bulk_time_per_s") - f("steps_per_s") * f("dt")).abs() < 1e-9 * f("bulk_time_per_s"));
+    }
+    assert!(v["peer"].is_null() && v["pass"] == true);
+}
+
 #[test]
 fn bench_refine_quick_reports_the_ratio_to_the_uniform_kernel() {
     let o = hgym(&["bench", "refine", "--quick", "--json"]);

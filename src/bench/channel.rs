@@ -63,8 +63,8 @@ pub struct ChannelBench {
     pub pass: bool,
 }
 
-/// A developed-enough flow on `spec`'s grid at `level` (a disturbed laminar start, so that the
-/// step does the work of a turbulent one) and its step.
+/// `spec`'s flow on the grid `n` from a disturbed laminar start (a step costs the same on any
+/// field), and its environment's step.
 fn solver(spec: &ChannelSpec, n: [usize; 3]) -> Result<(Channel, f64), BenchError> {
     let mut s = spec.clone();
     s.grid.default = n;
