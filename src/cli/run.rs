@@ -72,7 +72,7 @@ pub fn run(args: RunArgs) -> Result<Outcome> {
         "{}: starting from the developed flow (spun up once per ID and level, then cached)",
         spec.id()
     );
-    let pb = Progress::new(args.steps as u64, &spec.id());
+    let pb = Progress::new(args.steps as u64, spec.id());
     super::train::install_interrupt();
     let summary = pool
         .install(|| {
