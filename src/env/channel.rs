@@ -405,11 +405,7 @@ impl FamilySpec for ChannelSpec {
         table: Option<&Path>,
         progress: &mut dyn FnMut(usize),
     ) -> Result<(String, PathBuf), CalibrateError> {
-        if actions == 0 {
-            return Err(CalibrateError::NoActions);
-        }
-        let table = table.map_or_else(|| PathBuf::from(TABLE_PATH), Path::to_path_buf);
-        crate::report::table::check::<ChannelStatistics>(&table)?;
+        let table = super::family::calibration_table::<ChannelStatistics>(actions, table, TABLE_PATH)?;
         let st = calibrate(self, level, actions, cache, progress)?;
         let summary = format!(
             "{}: tau_w {:.5e} (Re_tau {:.1}), u'_rms+ {:.3}, v'_rms+ {:.3} at y+ {} over {:.1} h/U_b",

@@ -115,6 +115,21 @@ pub(crate) fn uncontrolled_step<E: hgym_agents::Env + ?Sized>(
     Ok(r)
 }
 
+/// What every calibration checks before it runs: at least one action, and a table (`table`, else
+/// the family's `committed` one) that reads as a table of `T` (or does not exist yet).
+pub(crate) fn calibration_table<T: DeserializeOwned>(
+    actions: usize,
+    table: Option<&Path>,
+    committed: &str,
+) -> Result<PathBuf, CalibrateError> {
+    if actions == 0 {
+        return Err(CalibrateError::NoActions);
+    }
+    let table = table.map_or_else(|| PathBuf::from(committed), Path::to_path_buf);
+    crate::report::table::check::<T>(&table)?;
+    Ok(table)
+}
+
 /// Why a calibration did not record its statistics.
 #[derive(Debug, thiserror::Error)]
 pub enum CalibrateError {

@@ -248,11 +248,7 @@ impl FamilySpec for KolmogorovSpec {
         table: Option<&Path>,
         progress: &mut dyn FnMut(usize),
     ) -> Result<(String, PathBuf), CalibrateError> {
-        if actions == 0 {
-            return Err(CalibrateError::NoActions);
-        }
-        let table = table.map_or_else(|| PathBuf::from(TABLE_PATH), Path::to_path_buf);
-        crate::report::table::check::<FlowStatistics>(&table)?;
+        let table = super::family::calibration_table::<FlowStatistics>(actions, table, TABLE_PATH)?;
         let st = calibrate(self, level, actions, progress)?;
         let summary = format!(
             "{}: u_rms {:.4}, dissipation {:.4} +- {:.4} (laminar {:.4}), TKE {:.4} over {} time units",

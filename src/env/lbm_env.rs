@@ -705,11 +705,7 @@ impl FamilySpec for EnvSpec {
         table: Option<&Path>,
         progress: &mut dyn FnMut(usize),
     ) -> Result<(String, PathBuf), CalibrateError> {
-        if actions == 0 {
-            return Err(CalibrateError::NoActions);
-        }
-        let table = table.map_or_else(|| PathBuf::from(super::calibrate::TABLE_PATH), Path::to_path_buf);
-        crate::report::table::check::<super::calibrate::Entry>(&table)?;
+        let table = super::family::calibration_table::<super::calibrate::Entry>(actions, table, super::calibrate::TABLE_PATH)?;
         let entry = super::calibrate::calibrate(self, level, actions, cache, &mut |k, _| progress(k))?;
         let summary = match entry.mean_forces {
             Some([c_d, c_l]) => format!("{}: uncontrolled mean C_D {c_d:.4}, mean C_L {c_l:.4}", self.id),
