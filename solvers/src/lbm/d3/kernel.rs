@@ -6,14 +6,14 @@
 //! row after row, and the hardware prefetchers see `Q` long streams (with a row-interleaved
 //! layout they saw `Q` short rows per row and the kernel stalled on memory latency: 9 MLUPS).
 //! Node `x` pulls `f_i(x) = f*_i(x - c_i)`. The bulk loop runs `x = 1 .. nx-2` branch-free over
-//! `Q` shifted source rows; the row's specials (its two ends, where `x` wraps, and every node
-//! that is solid or has a link into a body) then run the general path and overwrite their
-//! values.
+//! `Q` shifted source rows (along a periodic x its two ends too, with their wrapped pulls); the
+//! row's specials (its two ends at a non-periodic x face, and every node that is solid or has a
+//! link into a body) then run the general path and overwrite their values.
 
 use super::super::collision::Relax;
 pub(crate) use super::super::kernel::Special;
 use super::super::kernel::{nt_rows_possible, store_fence, stream_aligned};
-use super::collision::{collide, collide_chunk, CHUNK};
+use super::collision::{collide, collide_chunk, Ends, CHUNK};
 use super::lattice::Lattice3;
 use super::sides::{face_value, Faces};
 
@@ -155,11 +155,13 @@ pub(crate) fn gather<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p: [u
 /// vectors when `nx` is a multiple of 8), collided by [`collide_chunk`] into an L1-resident
 /// buffer (at most 27 x 128 x 4 = 14 KB) and written out, with non-temporal stores when the
 /// arrays are larger than the caches (no read-for-ownership of the destination: `2 Q 4` bytes
-/// of traffic per node instead of `3 Q 4`). The values at `x = 0` and `nx - 1` are wrong (their
-/// pulls wrap into the next row) and are overwritten by the specials.
+/// of traffic per node instead of `3 Q 4`). Along a periodic x, the two ends' pulls across the
+/// axis are read separately ([`Ends`]); otherwise the values at `x = 0` and `nx - 1` are wrong
+/// (their pulls run into the neighbouring rows) and are overwritten by the specials.
 #[inline(always)]
 fn bulk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
     c: &Ctx,
+    src: &[f32],
     src_ext: &[f32],
     y: usize,
     z: usize,
@@ -168,13 +170,32 @@ fn bulk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const 
 ) {
     let [nx, ny, _] = c.n;
     let s: [&[f32]; Q] = std::array::from_fn(|i| c.row_source::<Q, L>(src_ext, y, z, i));
+    // Along a periodic x the row's two ends pull across it.
+    let wrapped = |x: usize| -> [f32; Q] {
+        std::array::from_fn(|i| {
+            let c_i = L::C_REF[i];
+            let xs = (x as isize - c_i[0] as isize).rem_euclid(nx as isize) as usize;
+            let ys = (y as isize - c_i[1] as isize).rem_euclid(c.n[1] as isize) as usize;
+            let zs = (z as isize - c_i[2] as isize).rem_euclid(c.n[2] as isize) as usize;
+            src[c.idx::<Q>([xs, ys, zs], i)]
+        })
+    };
+    let (first, last) = if c.periodic[0] {
+        (Some(wrapped(0)), Some(wrapped(nx - 1)))
+    } else {
+        (None, None)
+    };
     let stream = c.stream_stores && nt_rows_possible(&out[y * nx..], nx);
     let mut c0 = 0;
     while c0 < nx {
         let c1 = (c0 + CHUNK).min(nx);
         let m = c1 - c0;
         let t: [&[f32]; Q] = std::array::from_fn(|i| &s[i][c0..c1]);
-        collide_chunk::<Q, L, OP, FORCED, LES>(&t, m, buf, c.relax, c.force);
+        let ends = Ends {
+            first: first.as_ref().filter(|_| c0 == 0),
+            last: last.as_ref().filter(|_| c1 == nx),
+        };
+        collide_chunk::<Q, L, OP, FORCED, LES>(&t, m, ends, buf, c.relax, c.force);
         for (i, b) in buf.iter().enumerate() {
             let row = (i * ny + y) * nx;
             let dst = &mut out[row + c0..row + c1];
@@ -205,7 +226,7 @@ pub(crate) fn plane<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: 
     for y in 0..ny {
         let r = z * ny + y;
         if nx >= 3 && c.row_bulk[r] {
-            bulk::<Q, L, OP, FORCED, LES>(c, src_ext, y, z, out, &mut buf);
+            bulk::<Q, L, OP, FORCED, LES>(c, src, src_ext, y, z, out, &mut buf);
         }
         let specials = &c.specials[c.row_start[r] as usize..c.row_start[r + 1] as usize];
         for sp in specials {

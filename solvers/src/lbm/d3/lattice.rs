@@ -22,6 +22,9 @@ pub trait Lattice3<const Q: usize>: Copy + Send + Sync + 'static {
     const C_REF: &'static [[i32; 3]; Q] = &Self::C;
     const W_REF: &'static [f32; Q] = &Self::W;
     const OPP_REF: &'static [usize; Q] = &Self::OPP;
+    /// Compile-time check that direction 0 is the rest and directions `2p + 1` and `2p + 2` are
+    /// opposites, the pairs the collision is written on (evaluated where the collision uses it).
+    const PAIRED: () = assert!(paired(&Self::C), "directions 2p+1 and 2p+2 must be opposites");
     /// Bytes moved per cell update by the fused A-B kernel with FP32 storage: `Q` populations
     /// read and `Q` written (152 for D3Q19, 216 for D3Q27).
     const BYTES_PER_CELL_F32: usize = 2 * Q * 4;
@@ -42,6 +45,22 @@ const fn opposites<const Q: usize>(c: &[[i32; 3]; Q]) -> [usize; Q] {
         i += 1;
     }
     opp
+}
+
+/// Whether `c[0]` is the rest and `c[2p + 1] = -c[2p + 2]` for every pair.
+const fn paired<const Q: usize>(c: &[[i32; 3]; Q]) -> bool {
+    if Q.is_multiple_of(2) || c[0][0] != 0 || c[0][1] != 0 || c[0][2] != 0 {
+        return false;
+    }
+    let mut p = 0;
+    while 2 * p + 2 < Q {
+        let (a, b) = (c[2 * p + 1], c[2 * p + 2]);
+        if a[0] != -b[0] || a[1] != -b[1] || a[2] != -b[2] {
+            return false;
+        }
+        p += 1;
+    }
+    true
 }
 
 /// The rest, axis and edge velocities shared by both sets.

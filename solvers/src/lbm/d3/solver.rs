@@ -262,7 +262,9 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                         }
                     }
                     let end = links.len() as u32;
-                    if !bulk || is_solid || end > start || x == 0 || x + 1 >= nx {
+                    // A row's ends wrap along a periodic x inside the bulk loop (which needs 3 nodes).
+                    let end_node = (x == 0 || x + 1 >= nx) && !(periodic[0] && nx >= 3);
+                    if !bulk || is_solid || end > start || end_node {
                         specials.push(Special {
                             x: x as u32,
                             solid: is_solid,
