@@ -96,16 +96,28 @@ impl Ctx<'_> {
     /// What direction `i` pulls into the nodes `x = 0 .. nx-1` of row `(y, z)`: element `x` is
     /// the source's value at `x - c_x` of row `(y - c_y, z - c_z)`, read from the padded source
     /// (logical element `k` at `k + PAD`). At `x = 0` or `nx - 1` that can be the neighbouring
-    /// row's end or the padding, never out of bounds; those two nodes are specials and are
-    /// overwritten.
+    /// row's end or the padding, never out of bounds (see [`bulk`] for those two nodes). Also
+    /// returns where the source row starts in the unpadded array.
     #[inline(always)]
-    fn row_source<'s, const Q: usize, L: Lattice3<Q>>(&self, src_ext: &'s [f32], y: usize, z: usize, i: usize) -> &'s [f32] {
+    fn row_source<'s, const Q: usize, L: Lattice3<Q>>(&self, src_ext: &'s [f32], y: usize, z: usize, i: usize) -> (usize, &'s [f32]) {
         let c = L::C_REF[i];
-        let ys = (y as isize - c[1] as isize).rem_euclid(self.n[1] as isize) as usize;
-        let zs = (z as isize - c[2] as isize).rem_euclid(self.n[2] as isize) as usize;
-        let start = (index::<Q>(self.n, [0, ys, zs], i) + PAD) as isize - c[0] as isize;
-        let start = start as usize;
-        &src_ext[start..start + self.n[0]]
+        let ys = wrap(y, -c[1], self.n[1]);
+        let zs = wrap(z, -c[2], self.n[2]);
+        let row = index::<Q>(self.n, [0, ys, zs], i);
+        let start = ((row + PAD) as isize - c[0] as isize) as usize;
+        (row, &src_ext[start..start + self.n[0]])
+    }
+}
+
+/// `v + d` wrapped into `0 .. n` for `|d| <= 1` (no division: this runs per row and direction).
+#[inline(always)]
+fn wrap(v: usize, d: i32, n: usize) -> usize {
+    match d {
+        1 if v + 1 == n => 0,
+        1 => v + 1,
+        -1 if v == 0 => n - 1,
+        -1 => v - 1,
+        _ => v,
     }
 }
 
@@ -151,11 +163,11 @@ pub(crate) fn gather<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p: [u
     g
 }
 
-/// The bulk of row `(y, z)`: every node `x = 0 .. nx-1` in chunks of [`CHUNK`] nodes (whole
-/// vectors when `nx` is a multiple of 8), collided by [`collide_chunk`] into an L1-resident
-/// buffer (at most 27 x 128 x 4 = 14 KB) and written out, with non-temporal stores when the
-/// arrays are larger than the caches (no read-for-ownership of the destination: `2 Q 4` bytes
-/// of traffic per node instead of `3 Q 4`). Along a periodic x, the two ends' pulls across the
+/// The bulk of row `(y, z)`: every node `x = 0 .. nx-1` in chunks of [`CHUNK`] nodes, collided
+/// by [`collide_chunk`] into an L1-resident buffer (at most 27 x 128 x 4 = 14 KB) and written
+/// out, with non-temporal stores when the arrays are larger than the caches
+/// (no read-for-ownership of the destination: `2 Q 4` bytes of traffic per node instead of
+/// `3 Q 4`). Along a periodic x, the two ends' pulls across the
 /// axis are read separately ([`Ends`]); otherwise the values at `x = 0` and `nx - 1` are wrong
 /// (their pulls run into the neighbouring rows) and are overwritten by the specials.
 #[inline(always)]
@@ -169,40 +181,44 @@ fn bulk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const 
     buf: &mut [[f32; CHUNK]; Q],
 ) {
     let [nx, ny, _] = c.n;
-    let s: [&[f32]; Q] = std::array::from_fn(|i| c.row_source::<Q, L>(src_ext, y, z, i));
-    // Along a periodic x the row's two ends pull across it.
-    let wrapped = |x: usize| -> [f32; Q] {
-        std::array::from_fn(|i| {
-            let c_i = L::C_REF[i];
-            let xs = (x as isize - c_i[0] as isize).rem_euclid(nx as isize) as usize;
-            let ys = (y as isize - c_i[1] as isize).rem_euclid(c.n[1] as isize) as usize;
-            let zs = (z as isize - c_i[2] as isize).rem_euclid(c.n[2] as isize) as usize;
-            src[c.idx::<Q>([xs, ys, zs], i)]
-        })
-    };
-    let (first, last) = if c.periodic[0] {
-        (Some(wrapped(0)), Some(wrapped(nx - 1)))
-    } else {
-        (None, None)
+    // Source rows, and along a periodic x the row's two ends' pulls across it (from the same
+    // source rows). Plain loops: `array::from_fn` closures are not inlined here.
+    let periodic_x = c.periodic[0];
+    let mut s: [&[f32]; Q] = [&[]; Q];
+    let (mut first, mut last) = ([0.0f32; Q], [0.0f32; Q]);
+    for i in 0..Q {
+        let (row, si) = c.row_source::<Q, L>(src_ext, y, z, i);
+        s[i] = si;
+        if periodic_x {
+            let c_x = L::C_REF[i][0];
+            if c_x == 1 {
+                first[i] = src[row + nx - 1];
+            }
+            if c_x == -1 {
+                last[i] = src[row];
+            }
+        }
+    }
+    let ends = Ends {
+        first: Some(&first).filter(|_| periodic_x),
+        last: Some(&last).filter(|_| periodic_x),
     };
     let stream = c.stream_stores && nt_rows_possible(&out[y * nx..], nx);
     let mut c0 = 0;
     while c0 < nx {
         let c1 = (c0 + CHUNK).min(nx);
-        let m = c1 - c0;
-        let t: [&[f32]; Q] = std::array::from_fn(|i| &s[i][c0..c1]);
-        let ends = Ends {
-            first: first.as_ref().filter(|_| c0 == 0),
-            last: last.as_ref().filter(|_| c1 == nx),
-        };
-        collide_chunk::<Q, L, OP, FORCED, LES>(&t, m, ends, buf, c.relax, c.force);
+        let mut t: [&[f32]; Q] = [&[]; Q];
+        for i in 0..Q {
+            t[i] = &s[i][c0..c1];
+        }
+        collide_chunk::<Q, L, OP, FORCED, LES>(&t, c0, c1 - c0, nx, ends, buf, c.relax, c.force);
         for (i, b) in buf.iter().enumerate() {
             let row = (i * ny + y) * nx;
             let dst = &mut out[row + c0..row + c1];
             if stream {
-                stream_aligned(dst, &b[..m]);
+                stream_aligned(dst, &b[..c1 - c0]);
             } else {
-                dst.copy_from_slice(&b[..m]);
+                dst.copy_from_slice(&b[..c1 - c0]);
             }
         }
         c0 = c1;
