@@ -3,10 +3,10 @@
 //! from signed distances, moving walls, momentum-exchange forces per body and per spanwise
 //! segment) and trilinear probes.
 //!
-//! Same habits as the 2D kernel: shifted FP32 storage, structure of arrays (`f[((z ny + y) Q +
-//! i) nx + x]`), one fused pull-scheme stream-collide pass per step over two arrays, rayon over
-//! rows, no allocation in a step, and a slow oracle ([`Lbm3::step_reference`]) the fast kernel
-//! is tested against bitwise. After a step, `f` holds the post-collision populations.
+//! Same habits as the 2D kernel: shifted FP32 storage, structure of arrays (`f[((z Q + i) ny +
+//! y) nx + x]`), one fused pull-scheme stream-collide pass per step over two arrays, rayon over
+//! z planes, no allocation in a step, and a slow oracle ([`Lbm3::step_reference`]) the fast
+//! kernel is tested against bitwise. After a step, `f` holds the post-collision populations.
 
 // Loops over directions `i` and axes `a` index several arrays at once, as the sums in the
 // equations do.
