@@ -22,6 +22,7 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 use wide::f32x8;
 
 use super::super::collision::{Relax, OMEGA_BULK, OP_BGK};
+use super::super::kernel::prefetch;
 use super::lattice::Lattice3;
 
 /// Density deviation and momentum: `drho = sum g_i`, `j = sum c_i g_i`.
@@ -282,17 +283,6 @@ pub struct Ends<'a, const Q: usize> {
 
 /// How far ahead (floats) of the block being loaded each source row is prefetched.
 const PREFETCH_AHEAD: usize = 64;
-
-/// Asks for the cache line holding `p` (`prefetcht0`). A hint: it never faults and changes no
-/// result, so `p` may point anywhere.
-#[inline(always)]
-fn prefetch(p: *const f32) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch reads no memory architecturally and cannot fault, whatever the address.
-    unsafe {
-        core::arch::x86_64::_mm_prefetch::<{ core::arch::x86_64::_MM_HINT_T0 }>(p as *const i8)
-    };
-}
 
 /// Nodes per chunk of [`collide_chunk`].
 pub const CHUNK: usize = 128;
@@ -561,17 +551,6 @@ mod tests {
         }
         check::<19, D3q19>();
         check::<27, D3q27>();
-    }
-
-    /// The prefetch hint accepts any address, mapped or not, and changes nothing.
-    #[test]
-    fn prefetch_never_faults() {
-        let v = [1.0f32; 4];
-        prefetch(v.as_ptr().wrapping_add(2));
-        prefetch(std::ptr::null());
-        prefetch(usize::MAX as *const f32);
-        prefetch(v.as_ptr().wrapping_add(1 << 40));
-        assert_eq!(v, [1.0; 4]);
     }
 
     #[test]
