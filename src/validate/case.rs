@@ -44,6 +44,7 @@ pub const BUNDLED: &[(&str, &str)] = &[
     ),
     ("square_re200.toml", include_str!("../../benchmarks/validation/square_re200.toml")),
     ("square_re1000.toml", include_str!("../../benchmarks/validation/square_re1000.toml")),
+    ("sphere_re100.toml", include_str!("../../benchmarks/validation/sphere_re100.toml")),
 ];
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
