@@ -5,8 +5,8 @@
 //! planes, so what direction `i` pulls into plane `z` is one contiguous block of plane `z - c_z`,
 //! row after row, and the hardware prefetchers see `Q` long streams (with a row-interleaved
 //! layout they saw `Q` short rows per row and the kernel stalled on memory latency: 9 MLUPS).
-//! Node `x` pulls `f_i(x) = f*_i(x - c_i)`. The bulk loop runs `x = 1 .. nx-2` branch-free over
-//! `Q` shifted source rows (along a periodic x its two ends too, with their wrapped pulls); the
+//! Node `x` pulls `f_i(x) = f*_i(x - c_i)`. The bulk loop runs `x = 0 .. nx-1` branch-free over
+//! `Q` shifted source rows (along a periodic x the two ends with their wrapped pulls); the
 //! row's specials (its two ends at a non-periodic x face, and every node that is solid or has a
 //! link into a body) then run the general path and overwrite their values.
 
@@ -165,11 +165,11 @@ pub(crate) fn gather<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p: [u
 
 /// The bulk of row `(y, z)`: every node `x = 0 .. nx-1` in chunks of [`CHUNK`] nodes, collided
 /// by [`collide_chunk`] into an L1-resident buffer (at most 27 x 128 x 4 = 14 KB) and written
-/// out, with non-temporal stores when the arrays are larger than the caches
-/// (no read-for-ownership of the destination: `2 Q 4` bytes of traffic per node instead of
-/// `3 Q 4`). Along a periodic x, the two ends' pulls across the
-/// axis are read separately ([`Ends`]); otherwise the values at `x = 0` and `nx - 1` are wrong
-/// (their pulls run into the neighbouring rows) and are overwritten by the specials.
+/// out, with non-temporal stores when the arrays are larger than the caches (no
+/// read-for-ownership of the destination: `2 Q 4` bytes of traffic per node instead of `3 Q 4`).
+/// Along a periodic x the two ends' pulls across the axis are read separately ([`Ends`]);
+/// otherwise the values at `x = 0` and `nx - 1` are wrong (their pulls run into the neighbouring
+/// rows) and are overwritten by the specials.
 #[inline(always)]
 fn bulk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
     c: &Ctx,
@@ -199,9 +199,13 @@ fn bulk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const 
             }
         }
     }
-    let ends = Ends {
-        first: Some(&first).filter(|_| periodic_x),
-        last: Some(&last).filter(|_| periodic_x),
+    let ends = if periodic_x {
+        Ends {
+            first: Some(&first),
+            last: Some(&last),
+        }
+    } else {
+        Ends::default()
     };
     let stream = c.stream_stores && nt_rows_possible(&out[y * nx..], nx);
     let mut c0 = 0;
