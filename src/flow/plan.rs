@@ -16,6 +16,36 @@ pub const MAX_NODES: usize = 50_000_000;
 /// Bytes of populations per node: nine f32 values, in two copies.
 pub const BYTES_PER_NODE: usize = 72;
 
+/// Memory this machine can still hand out (`MemAvailable` of `/proc/meminfo`), in bytes; `None`
+/// where that cannot be read (then only [`MAX_NODES`] bounds a grid).
+pub fn available_memory() -> Option<f64> {
+    mem_available(&std::fs::read_to_string("/proc/meminfo").ok()?)
+}
+
+/// The `MemAvailable:` line of a `/proc/meminfo` text (kB), in bytes.
+fn mem_available(meminfo: &str) -> Option<f64> {
+    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024.0)
+}
+
+/// Refuses a grid of `cells` whose populations (`need` bytes) exceed the memory the machine has
+/// available, naming both.
+fn fits_in_memory(cells: &str, need: f64, available: Option<f64>) -> Result<(), FlowError> {
+    match available {
+        Some(have) if need > have => Err(FlowError::Invalid {
+            field: "resolution",
+            message: format!(
+                "{cells} cells need {:.1} GB of populations, more than the {:.1} GB this machine has available; \
+                 use a coarser level, a smaller domain, or a machine with more memory",
+                need / 1e9,
+                have / 1e9
+            ),
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// A cell count as digits while it is readable, else in scientific notation.
 fn count(v: f64) -> String {
     if v < 1e9 {
@@ -172,6 +202,11 @@ impl FlowSetup {
             });
         }
         let (nx, ny) = (nx_f.round() as usize, ny_f.round() as usize);
+        let cells = match nz {
+            Some(nz) => format!("{nx} x {ny} x {nz}"),
+            None => format!("{nx} x {ny}"),
+        };
+        fits_in_memory(&cells, nx_f * ny_f * nz_f * bytes as f64, available_memory())?;
         if nx < 8 || ny < 8 {
             return Err(FlowError::Invalid {
                 field: "domain",
@@ -225,5 +260,29 @@ impl FlowSetup {
             collision: self.collision,
             refinement,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_mem_available_from_meminfo() {
+        let text = "MemTotal:       24598416 kB\nMemFree:         1000000 kB\nMemAvailable:   20000000 kB\n";
+        assert_eq!(mem_available(text), Some(20_000_000.0 * 1024.0));
+        assert_eq!(mem_available("MemTotal: 5 kB\n"), None);
+        assert_eq!(mem_available("MemAvailable: lots kB\n"), None);
+    }
+
+    /// A grid larger than the machine's available memory is refused naming the field and both
+    /// sizes; one that fits, or a machine whose memory cannot be read, passes.
+    #[test]
+    fn refuses_grids_beyond_the_available_memory() {
+        let err = fits_in_memory("320 x 192 x 192", 1.8e9, Some(1.0e9)).unwrap_err().to_string();
+        assert!(err.starts_with("`resolution`"), "{err}");
+        assert!(err.contains("1.8 GB") && err.contains("1.0 GB"), "{err}");
+        assert!(fits_in_memory("320 x 192 x 192", 1.8e9, Some(2.0e9)).is_ok());
+        assert!(fits_in_memory("320 x 192 x 192", 1.8e9, None).is_ok());
     }
 }
