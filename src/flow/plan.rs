@@ -29,21 +29,33 @@ fn mem_available(meminfo: &str) -> Option<f64> {
     Some(kb * 1024.0)
 }
 
-/// Refuses a grid of `cells` whose populations (`need` bytes) exceed the memory the machine has
-/// available, naming both.
-fn fits_in_memory(cells: &str, need: f64, available: Option<f64>) -> Result<(), FlowError> {
-    match available {
-        Some(have) if need > have => Err(FlowError::Invalid {
-            field: "resolution",
-            message: format!(
-                "{cells} cells need {:.1} GB of populations, more than the {:.1} GB this machine has available; \
-                 use a coarser level, a smaller domain, or a machine with more memory",
-                need / 1e9,
-                have / 1e9
-            ),
-        }),
-        _ => Ok(()),
-    }
+/// Refuses a grid of `cells` whose populations (`need` bytes, `bytes` per cell) exceed the
+/// fixed limit ([`MAX_NODES`] D2Q9 cells' worth) or the memory the machine has `available`,
+/// naming the limit that binds. Compared as floats: a huge domain must not wrap when cast to
+/// `usize`, and a NaN size is refused.
+fn fits_in_memory(cells: &str, need: f64, bytes: usize, available: Option<f64>) -> Result<(), FlowError> {
+    let max_bytes = (MAX_NODES * BYTES_PER_NODE) as f64;
+    let message = if !(need <= max_bytes) {
+        format!(
+            "{cells} cells would need {} GB of populations ({bytes} bytes per cell); the limit is {} cells ({:.1} GB): use a coarser level or a smaller domain",
+            count(need / 1e9),
+            (max_bytes as usize) / bytes,
+            max_bytes / 1e9
+        )
+    } else if let Some(have) = available.filter(|&have| need > have) {
+        format!(
+            "{cells} cells need {:.1} GB of populations, more than the {:.1} GB this machine has available; \
+             use a coarser level, a smaller domain, or a machine with more memory",
+            need / 1e9,
+            have / 1e9
+        )
+    } else {
+        return Ok(());
+    };
+    Err(FlowError::Invalid {
+        field: "resolution",
+        message,
+    })
 }
 
 /// A cell count as digits while it is readable, else in scientific notation.
@@ -184,29 +196,12 @@ impl FlowSetup {
         };
         let bytes = self.span.as_ref().map_or(BYTES_PER_NODE, |s| s.lattice.bytes_per_node());
         let nz_f = nz.unwrap_or(1) as f64;
-        // Compared as floats first: a huge domain must not wrap when cast to usize.
-        let max_bytes = (MAX_NODES * BYTES_PER_NODE) as f64;
-        if !(nx_f * ny_f * nz_f * bytes as f64 <= max_bytes) {
-            let cells = match nz {
-                Some(nz) => format!("{} x {} x {nz}", count(nx_f), count(ny_f)),
-                None => format!("{} x {}", count(nx_f), count(ny_f)),
-            };
-            return Err(FlowError::Invalid {
-                field: "resolution",
-                message: format!(
-                    "{cells} cells would need {} GB of populations ({bytes} bytes per cell); the limit is {} cells ({:.1} GB): use a coarser level or a smaller domain",
-                    count(nx_f * ny_f * nz_f * bytes as f64 / 1e9),
-                    (max_bytes as usize) / bytes,
-                    max_bytes / 1e9
-                ),
-            });
-        }
-        let (nx, ny) = (nx_f.round() as usize, ny_f.round() as usize);
         let cells = match nz {
-            Some(nz) => format!("{nx} x {ny} x {nz}"),
-            None => format!("{nx} x {ny}"),
+            Some(nz) => format!("{} x {} x {nz}", count(nx_f), count(ny_f)),
+            None => format!("{} x {}", count(nx_f), count(ny_f)),
         };
-        fits_in_memory(&cells, nx_f * ny_f * nz_f * bytes as f64, available_memory())?;
+        fits_in_memory(&cells, nx_f * ny_f * nz_f * bytes as f64, bytes, available_memory())?;
+        let (nx, ny) = (nx_f.round() as usize, ny_f.round() as usize);
         if nx < 8 || ny < 8 {
             return Err(FlowError::Invalid {
                 field: "domain",
@@ -279,10 +274,10 @@ mod tests {
     /// sizes; one that fits, or a machine whose memory cannot be read, passes.
     #[test]
     fn refuses_grids_beyond_the_available_memory() {
-        let err = fits_in_memory("320 x 192 x 192", 1.8e9, Some(1.0e9)).unwrap_err().to_string();
+        let err = fits_in_memory("320 x 192 x 192", 1.8e9, 152, Some(1.0e9)).unwrap_err().to_string();
         assert!(err.starts_with("`resolution`"), "{err}");
         assert!(err.contains("1.8 GB") && err.contains("1.0 GB"), "{err}");
-        assert!(fits_in_memory("320 x 192 x 192", 1.8e9, Some(2.0e9)).is_ok());
-        assert!(fits_in_memory("320 x 192 x 192", 1.8e9, None).is_ok());
+        assert!(fits_in_memory("320 x 192 x 192", 1.8e9, 152, Some(2.0e9)).is_ok());
+        assert!(fits_in_memory("320 x 192 x 192", 1.8e9, 152, None).is_ok());
     }
 }
