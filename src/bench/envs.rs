@@ -1,14 +1,15 @@
-//! `hgym bench envs`: control steps (actions) per second of each environment family at the
-//! coarse and default levels, with the solver rate behind them. Reset (and the one-time spin-up,
-//! cached) is not timed.
+//! `hgym bench envs`: control steps (actions) per second of each lattice-Boltzmann environment
+//! family (2D and 3D) at the coarse and default levels, with the grid, the solver steps per
+//! action and the solver rate behind them. Reset (and the one-time spin-up, cached) is not timed.
 
 use std::time::Instant;
 
 use hgym_agents::Env;
 use serde::{Deserialize, Serialize};
 
-use crate::env::{registry, LbmEnv};
-use crate::flow::Level;
+use crate::env::spec3::Env3Spec;
+use crate::env::{registry, EnvSpec, Spec};
+use crate::flow::{FlowSetup, Level};
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct EnvBenchRow {
@@ -21,14 +22,26 @@ pub struct EnvBenchRow {
     pub mlups: f64,
 }
 
+/// The flow set-up and control interval of a lattice-Boltzmann spec (2D or 3D).
+fn lbm_flow(spec: &Spec) -> Option<(FlowSetup, f64)> {
+    if let Some(s) = spec.downcast::<EnvSpec>() {
+        return Some((s.flow_setup(), s.control_interval));
+    }
+    spec.downcast::<Env3Spec>().map(|s| (s.flow_setup(), s.control_interval))
+}
+
 /// The lattice-Boltzmann families `bench_envs` can time, sorted.
 pub fn families() -> Vec<String> {
-    let set: std::collections::BTreeSet<String> = registry::lbm_specs().into_iter().map(|s| s.family).collect();
+    let set: std::collections::BTreeSet<String> = registry::all()
+        .into_iter()
+        .filter(|s| lbm_flow(s).is_some())
+        .map(|s| s.family().to_string())
+        .collect();
     set.into_iter().collect()
 }
 
-/// Times `actions` random-sign actions on one ID per family at each level; `families` limits
-/// the run to those families (all when empty; see [`families`]).
+/// Times `actions` random-sign actions on one ID per family and dimension (the first registered)
+/// at each level; `families` limits the run to those families (all when empty; see [`families`]).
 pub fn bench_envs(
     levels: &[Level],
     actions: usize,
@@ -38,16 +51,25 @@ pub fn bench_envs(
 ) -> Result<Vec<EnvBenchRow>, hgym_agents::EnvError> {
     let mut seen = std::collections::BTreeSet::new();
     let mut rows = Vec::new();
-    for spec in registry::lbm_specs() {
-        if !families.is_empty() && !families.contains(&spec.family) {
+    for spec in registry::all() {
+        let Some((setup, interval)) = lbm_flow(&spec) else {
+            continue;
+        };
+        let family = spec.family().to_string();
+        if !families.is_empty() && !families.contains(&family) {
             continue;
         }
-        if !seen.insert(spec.family.clone()) {
+        if !seen.insert((family.clone(), spec.dimension())) {
             continue;
         }
         for &level in levels {
-            let mut env = LbmEnv::new(spec.clone(), level, cache.clone())?;
-            progress(&format!("{} ({}): reset", spec.id, level.name()));
+            let plan = setup
+                .plan(level)
+                .map_err(|e| hgym_agents::EnvError::InvalidSpec(format!("{}: {e}", spec.id())))?;
+            let cells = plan.nx * plan.ny * plan.nz.unwrap_or(1);
+            let steps_per_action = plan.units.steps(interval).max(1);
+            let mut env = spec.make(level, cache.clone())?;
+            progress(&format!("{} ({}): reset", spec.id(), level.name()));
             env.reset(0)?;
             let dim = spec.act_dim();
             let t = Instant::now();
@@ -59,16 +81,14 @@ pub fn bench_envs(
                 }
             }
             let dt = t.elapsed().as_secs_f64();
-            let s = env.solver();
-            let cells = s.nx() * s.ny();
             let row = EnvBenchRow {
-                id: spec.id.clone(),
-                family: spec.family.clone(),
+                id: spec.id().to_string(),
+                family: family.clone(),
                 level: level.name().into(),
                 cells,
-                steps_per_action: env.steps_per_action(),
+                steps_per_action,
                 actions_per_s: actions as f64 / dt,
-                mlups: (cells as u64 * env.steps_per_action() * actions as u64) as f64 / dt / 1e6,
+                mlups: (cells as u64 * steps_per_action * actions as u64) as f64 / dt / 1e6,
             };
             progress(&format!("{} ({}): {:.1} actions/s", row.id, row.level, row.actions_per_s));
             rows.push(row);
@@ -79,13 +99,19 @@ pub fn bench_envs(
 
 pub fn table(rows: &[EnvBenchRow]) -> String {
     let mut s = format!(
-        "{:<26} {:<8} {:>9} {:>12} {:>10} {:>8}\n",
-        "ID", "level", "cells", "steps/action", "actions/s", "MLUPS"
+        "{:<26} {:<8} {:>9} {:>12} {:>10} {:>9} {:>8}\n",
+        "ID", "level", "cells", "steps/action", "actions/s", "s/action", "MLUPS"
     );
     for r in rows {
         s += &format!(
-            "{:<26} {:<8} {:>9} {:>12} {:>10.1} {:>8.0}\n",
-            r.id, r.level, r.cells, r.steps_per_action, r.actions_per_s, r.mlups
+            "{:<26} {:<8} {:>9} {:>12} {:>10.1} {:>9.3} {:>8.0}\n",
+            r.id,
+            r.level,
+            r.cells,
+            r.steps_per_action,
+            r.actions_per_s,
+            1.0 / r.actions_per_s,
+            r.mlups
         );
     }
     s

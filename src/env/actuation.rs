@@ -18,7 +18,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use hgym_solvers::lbm::{D2q9, Units, WallPoint};
+use hgym_solvers::lbm::{D2q9, Units};
+
+use super::spec::ActuationSpec;
+use crate::flow::GeometrySpec;
 
 /// Normalised ramp `R(tau)`, `R(0) = 0`, `R(1) = 1`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -110,37 +113,93 @@ pub fn rotation(omega: f64, center: [f64; 2], p: [f64; 2]) -> [f64; 2] {
     [-omega * (p[1] - center[1]), omega * (p[0] - center[0])]
 }
 
-/// What moves one body's wall: jets with their magnitudes, and an angular velocity (all in units
-/// of U and U/L).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct WallMotion<'a> {
-    pub jets: &'a [Jet],
-    pub amplitudes: &'a [f64],
-    pub rotation: Option<([f64; 2], f64)>,
+/// The jets and rotation centres of a section actuator, resolved against the bodies: for
+/// `ZnmfJets` the pair on its circle, for `ZnmfJetsPerBody` a pair per listed circle (jets
+/// `2k`, `2k + 1` on the `k`-th), for `Jets` the listed jets, for `Rotation` the centre of each
+/// listed circle. An actuated body that is not a circle (where one must be), or that does not
+/// exist, is an error naming it.
+pub fn resolve(spec: &ActuationSpec, bodies: &[GeometrySpec]) -> Result<(Vec<Jet>, Vec<[f64; 2]>), String> {
+    let circle = |i: usize| match bodies.get(i) {
+        Some(GeometrySpec::Circle { center, diameter }) => Ok((*center, 0.5 * diameter)),
+        _ => Err(format!("actuated body {i} must be a circle")),
+    };
+    Ok(match spec {
+        ActuationSpec::ZnmfJets {
+            body,
+            angles_deg,
+            span_deg,
+            ..
+        } => {
+            let (c, r) = circle(*body)?;
+            (angles_deg.iter().map(|a| Jet::on_circle(c, r, *a, *span_deg)).collect(), vec![])
+        }
+        ActuationSpec::ZnmfJetsPerBody {
+            bodies: listed,
+            angles_deg,
+            span_deg,
+            ..
+        } => {
+            let mut jets = vec![];
+            for &b in listed {
+                let (c, r) = circle(b)?;
+                jets.extend(angles_deg.iter().map(|a| Jet::on_circle(c, r, *a, *span_deg)));
+            }
+            (jets, vec![])
+        }
+        ActuationSpec::Jets { body, jets, .. } => {
+            if *body >= bodies.len() {
+                return Err(format!("jets on body {body}, which does not exist"));
+            }
+            (jets.clone(), vec![])
+        }
+        ActuationSpec::Rotation { bodies: listed, .. } => {
+            (vec![], listed.iter().map(|&i| circle(i).map(|c| c.0)).collect::<Result<_, _>>()?)
+        }
+        ActuationSpec::InletTemperature { .. } => (vec![], vec![]),
+    })
 }
 
-impl WallMotion<'_> {
-    /// Non-dimensional wall velocity at a wall point.
-    pub fn velocity(&self, wp: &WallPoint) -> [f64; 2] {
-        let mut u = [0.0, 0.0];
-        for (jet, a) in self.jets.iter().zip(self.amplitudes) {
-            let s = jet.profile(wp.position);
+/// Non-dimensional wall velocity (units of U) at the wall point `p` of body `b` under a section
+/// actuator with physical actions `a` (units of U or U/D; the temperature actuator moves no
+/// wall), `jets` and `centers` as [`resolve`] gives them:
+/// - `ZnmfJets`: the first jet blows `a_0`, the second sucks the same;
+/// - `ZnmfJetsPerBody`: on the `k`-th listed body, its pair blows and sucks `a_k`;
+/// - `Jets`: jet `k` blows `a_k`;
+/// - `Rotation`: the `k`-th listed body turns at `a_k`.
+pub fn section_velocity(spec: &ActuationSpec, jets: &[Jet], centers: &[[f64; 2]], b: usize, a: &[f64], p: [f64; 2]) -> [f64; 2] {
+    let mut u = [0.0, 0.0];
+    let mut blow = |jets: &[Jet], amplitudes: &mut dyn Iterator<Item = f64>| {
+        for (jet, a) in jets.iter().zip(amplitudes) {
+            let s = jet.profile(p);
             u[0] += a * s[0];
             u[1] += a * s[1];
         }
-        if let Some((c, w)) = self.rotation {
-            let r = rotation(w, c, wp.position);
-            u[0] += r[0];
-            u[1] += r[1];
+    };
+    match spec {
+        ActuationSpec::ZnmfJets { body, .. } if *body == b => blow(jets, &mut [a[0], -a[0]].into_iter()),
+        ActuationSpec::ZnmfJetsPerBody { bodies, .. } => {
+            if let Some(k) = bodies.iter().position(|&i| i == b) {
+                blow(&jets[2 * k..2 * k + 2], &mut [a[k], -a[k]].into_iter());
+            }
         }
-        u
+        ActuationSpec::Jets { body, .. } if *body == b => blow(jets, &mut a.iter().copied()),
+        ActuationSpec::Rotation { bodies, .. } => {
+            if let Some(k) = bodies.iter().position(|&i| i == b) {
+                let r = rotation(a[k], centers[k], p);
+                u[0] += r[0];
+                u[1] += r[1];
+            }
+        }
+        _ => {}
     }
+    u
 }
 
-/// Sets the wall velocity of every link of `body` from `motion`, converted to lattice units.
-pub fn apply(solver: &mut D2q9, body: usize, motion: &WallMotion, units: &Units) {
+/// Sets the wall velocity of every link of `body` from a section actuator (see
+/// [`section_velocity`]), converted to lattice units.
+pub fn apply(solver: &mut D2q9, body: usize, spec: &ActuationSpec, jets: &[Jet], centers: &[[f64; 2]], a: &[f64], units: &Units) {
     solver.set_wall_velocity(body, |wp| {
-        let u = motion.velocity(wp);
+        let u = section_velocity(spec, jets, centers, body, a, wp.position);
         [units.lattice_velocity(u[0]), units.lattice_velocity(u[1])]
     });
 }
@@ -240,29 +299,22 @@ mod tests {
         cfg.grid = grid;
         let body: Arc<dyn Shape> = Arc::new(Circle { center, radius: 0.5 });
         let mut s = D2q9::new(cfg, vec![body]).unwrap();
-        let jets = [Jet::on_circle(center, 0.5, 90.0, 10.0), Jet::on_circle(center, 0.5, 270.0, 10.0)];
+        let spec = ActuationSpec::ZnmfJets {
+            body: 0,
+            angles_deg: [90.0, 270.0],
+            span_deg: 10.0,
+            max_velocity: 1.0,
+        };
+        let (jets, _) = resolve(&spec, &[GeometrySpec::Circle { center, diameter: 1.0 }]).unwrap();
         let a = 0.8;
-        apply(
-            &mut s,
-            0,
-            &WallMotion {
-                jets: &jets,
-                amplitudes: &[a, -a],
-                rotation: None,
-            },
-            &units,
-        );
+        apply(&mut s, 0, &spec, &jets, &[], &[a], &units);
         let pair = s.wall_mass_source(0);
-        apply(
-            &mut s,
-            0,
-            &WallMotion {
-                jets: &jets[..1],
-                amplitudes: &[a],
-                rotation: None,
-            },
-            &units,
-        );
+        let one_jet = ActuationSpec::Jets {
+            body: 0,
+            jets: jets[..1].to_vec(),
+            max_velocity: 1.0,
+        };
+        apply(&mut s, 0, &one_jet, &jets[..1], &[], &[a], &units);
         let one = s.wall_mass_source(0);
         println!("ZNMF pair: net injected mass per step {pair:.3e}; one jet alone {one:.3e}");
         assert!(one.abs() > 1e-4, "a single jet must inject mass ({one})");

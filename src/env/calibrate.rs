@@ -82,14 +82,20 @@ pub fn attach(spec: &mut EnvSpec, table: &BTreeMap<String, Entry>) {
 }
 
 fn attach_entry(spec: &mut EnvSpec, entry: Option<&Entry>, hash: &str) {
-    if let Some(e) = entry {
-        if e.spec_hash == hash && e.mean.len() == spec.obs_dim() && e.scale.len() == spec.obs_dim() {
-            spec.normalization = Normalization {
-                mean: e.mean.clone(),
-                scale: e.scale.clone(),
-            };
-        }
+    if let Some(n) = matching(entry, hash, spec.obs_dim()) {
+        spec.normalization = n;
     }
+}
+
+/// The statistics of `entry` if they were computed for the physics hashed `hash` and have
+/// `obs_dim` values.
+pub(crate) fn matching(entry: Option<&Entry>, hash: &str, obs_dim: usize) -> Option<Normalization> {
+    entry
+        .filter(|e| e.spec_hash == hash && e.mean.len() == obs_dim && e.scale.len() == obs_dim)
+        .map(|e| Normalization {
+            mean: e.mean.clone(),
+            scale: e.scale.clone(),
+        })
 }
 
 /// Smallest normalisation scale (units of U, rho U^2 or T_wall): 1 % of the free stream. A probe
@@ -112,17 +118,35 @@ pub fn calibrate(
     raw_spec.normalization = Normalization::default();
     raw_spec.episode_actions = actions.max(1);
     let mut env = LbmEnv::new(raw_spec, level, cache)?;
+    let entry = statistics(&mut env, &spec.id, actions, LbmEnv::raw_observation, progress)?;
+    Ok(Entry {
+        spec_hash: physics_hash(spec),
+        level: level.name().into(),
+        ..entry
+    })
+}
+
+/// The statistics of an [`Entry`] (hash and level left empty) from `actions` uncontrolled
+/// intervals of `env` after `reset(0)`: the raw observation `raw(env)` at the end of each, and
+/// the mean total `C_D`, `C_L` of `info`.
+pub(crate) fn statistics<E: Env>(
+    env: &mut E,
+    id: &str,
+    actions: usize,
+    raw: impl Fn(&E) -> Result<Vec<f64>, EnvError>,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Entry, EnvError> {
     env.reset(0)?;
-    let dim = spec.obs_dim();
+    let dim = env.observation_space().dim();
     let (mut sum, mut sq) = (vec![0.0f64; dim], vec![0.0f64; dim]);
-    let zero = vec![0.0; spec.act_dim()];
+    let zero = vec![0.0; env.action_space().dim()];
     let mut forces = [0.0f64; 2];
     for k in 0..actions {
-        let r = super::family::uncontrolled_step(&mut env, &spec.id, &zero)?;
+        let r = super::family::uncontrolled_step(env, id, &zero)?;
         for (sum, key) in forces.iter_mut().zip(["C_D", "C_L"]) {
             *sum += super::info_value(&r.info, key)?;
         }
-        let raw = env.raw_observation()?;
+        let raw = raw(env)?;
         for i in 0..dim {
             sum[i] += raw[i];
             sq[i] += raw[i] * raw[i];
@@ -137,8 +161,8 @@ pub fn calibrate(
         .map(|(q, m)| (3.0 * (q / n - m * m).max(0.0).sqrt()).max(MIN_SCALE))
         .collect();
     Ok(Entry {
-        spec_hash: physics_hash(spec),
-        level: level.name().into(),
+        spec_hash: String::new(),
+        level: String::new(),
         actions,
         mean,
         scale,

@@ -2,6 +2,9 @@
 //! with a zero-net-mass-flux jet pair at 90 and 270 degrees (10 degrees wide, parabolic profile),
 //! and `RotaryCylinder_2D_Re{...}` with surface rotation.
 //!
+//! `Cylinder_3D_Re{200,1000,3900}` and `RotaryCylinder_3D_...` are the same on the paper's 3D box
+//! with a periodic span of 4 D cut into 1, 4 and 10 segments (see [`in_3d`]).
+//!
 //! Set-up from the paper: domain (x/D, y/D) in [0, 40] x [-10, 10], cylinder at (10, 0), uniform
 //! inflow, periodic sides, open outlet. Reward `r = -|C_D| - w |C_L|`, `w` = 0.1, 0.2, 1.0, 1.0 for
 //! Re = 100, 200, 1000, 3900. 200 actions per episode, about 10 shedding periods, so the control
@@ -19,12 +22,23 @@ use crate::flow::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, Resoluti
 /// The Reynolds numbers of the family.
 pub const REYNOLDS: [u32; 4] = [100, 200, 1000, 3900];
 
-/// The circular cylinder family: jets, then rotation, each over [`REYNOLDS`].
+/// The Reynolds numbers of the 3D IDs.
+pub const REYNOLDS_3D: [u32; 3] = [200, 1000, 3900];
+
+/// The circular cylinder family: jets, then rotation, each over [`REYNOLDS`], then the same in
+/// 3D over [`REYNOLDS_3D`].
 pub struct Cylinder;
 
 impl super::family::Family for Cylinder {
     fn specs(&self) -> Vec<super::family::Spec> {
-        super::registry::lbm(REYNOLDS.map(jets).into_iter().chain(REYNOLDS.map(rotary)))
+        let mut specs = super::registry::lbm(REYNOLDS.map(jets).into_iter().chain(REYNOLDS.map(rotary)));
+        specs.extend(super::registry::lbm3(
+            REYNOLDS_3D
+                .map(|re| in_3d(jets(re)))
+                .into_iter()
+                .chain(REYNOLDS_3D.map(|re| in_3d(rotary(re)))),
+        ));
+        specs
     }
 }
 
@@ -139,5 +153,59 @@ pub fn rotary(re: u32) -> EnvSpec {
             max_omega: 2.0,
         },
         format!("2D circular cylinder at Re {re}, surface rotation"),
+    )
+}
+
+/// Spanwise segments of the paper's 3D bluff bodies: one at Re 200, 4 at Re 1000, 10 at Re 3900
+/// (each a jet pair, or a rotating section, of its own: an agent in multi-agent training).
+fn segments_3d(re: f64) -> usize {
+    match re as u32 {
+        1000 => 4,
+        3900 => 10,
+        _ => 1,
+    }
+}
+
+/// The paper's 3D version of a 2D bluff-body environment (`*_2D_*` becomes `*_3D_*`): the box
+/// `[32 x 16 x 4] D` with 8 D in front of the body (here x in [2, 34], y in [-8, 8] around the
+/// 2D body at (10, 0)), periodic in y and z, the span cut into [`segments_3d`] segments. Levels
+/// 8, 16 and 24 cells per D (10, 20, 40 at Re 3900, whose 10 segments must divide the span's
+/// cells). Everything else as in 2D, the probes observed in each segment's mid-plane.
+pub(super) fn in_3d(base: EnvSpec) -> super::spec3::Env3Spec {
+    let re = base.reynolds;
+    let segments = segments_3d(re);
+    let resolution = if segments == 10 {
+        ResolutionSpec {
+            coarse: 10,
+            default: 20,
+            fine: 40,
+        }
+    } else {
+        ResolutionSpec {
+            coarse: 8,
+            default: 16,
+            fine: 24,
+        }
+    };
+    let id = base.id.replace("_2D_", "_3D_");
+    let description = format!(
+        "{} (3D, span 4 D in {segments} segment(s))",
+        base.description.replacen("2D ", "", 1)
+    );
+    super::spec3::extrude(
+        base,
+        id,
+        description,
+        DomainSpec {
+            x: [2.0, 34.0],
+            y: [-8.0, 8.0],
+        },
+        crate::flow::SpanSpec {
+            z: [-2.0, 2.0],
+            boundary: BoundaryKind::Periodic,
+            segments,
+            lattice: Default::default(),
+        },
+        resolution,
     )
 }

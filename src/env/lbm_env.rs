@@ -23,12 +23,12 @@ use hgym_agents::{checked_action, BoxSpace, Env, EnvError, Info, StepResult};
 use hgym_solvers::lbm::thermal::{Thermal, ThermalSide};
 use hgym_solvers::lbm::{D2q9, Edge, LbmError, Side, Units};
 
-use super::actuation::{apply, Jet, WallMotion};
+use super::actuation::{apply, Jet};
 use super::family::{merged, CalibrateError, FamilySpec, FlowEnv, Spec};
 use super::seeding::splitmix64;
 use super::spec::{ActuationSpec, EnvSpec, RewardSpec};
 use super::EnvInputError;
-use crate::flow::{FlowError, GeometrySpec, LbmFlow, Level};
+use crate::flow::{FlowError, LbmFlow, Level};
 
 pub struct LbmEnv {
     spec: EnvSpec,
@@ -117,51 +117,14 @@ impl LbmEnv {
             Default::default()
         };
         let steps_per_action = units.steps(spec.control_interval).max(1);
-        let circle = |i: usize| match spec.bodies.get(i) {
-            Some(GeometrySpec::Circle { center, diameter }) => Ok((*center, 0.5 * diameter)),
-            _ => Err(EnvError::InvalidSpec(format!("{}: actuated body {i} must be a circle", spec.id))),
-        };
-        let (jets, centers) = match &spec.actuation {
-            ActuationSpec::ZnmfJets {
-                body,
-                angles_deg,
-                span_deg,
-                ..
-            } => {
-                let (c, r) = circle(*body)?;
-                (angles_deg.iter().map(|a| Jet::on_circle(c, r, *a, *span_deg)).collect(), vec![])
-            }
-            ActuationSpec::ZnmfJetsPerBody {
-                bodies,
-                angles_deg,
-                span_deg,
-                ..
-            } => {
-                let mut jets = vec![];
-                for &b in bodies {
-                    let (c, r) = circle(b)?;
-                    jets.extend(angles_deg.iter().map(|a| Jet::on_circle(c, r, *a, *span_deg)));
-                }
-                (jets, vec![])
-            }
-            ActuationSpec::Jets { body, jets, .. } => {
-                if *body >= spec.bodies.len() {
-                    return Err(EnvError::InvalidSpec(format!(
-                        "{}: jets on body {body}, which does not exist",
-                        spec.id
-                    )));
-                }
-                (jets.clone(), vec![])
-            }
-            ActuationSpec::Rotation { bodies, .. } => (vec![], bodies.iter().map(|&i| circle(i).map(|c| c.0)).collect::<Result<_, _>>()?),
-            ActuationSpec::InletTemperature { .. } if thermal.is_none() => {
-                return Err(EnvError::InvalidSpec(format!(
-                    "{}: an inlet-temperature actuator needs a [thermal] section",
-                    spec.id
-                )));
-            }
-            ActuationSpec::InletTemperature { .. } => (vec![], vec![]),
-        };
+        if matches!(spec.actuation, ActuationSpec::InletTemperature { .. }) && thermal.is_none() {
+            return Err(EnvError::InvalidSpec(format!(
+                "{}: an inlet-temperature actuator needs a [thermal] section",
+                spec.id
+            )));
+        }
+        let (jets, centers) =
+            super::actuation::resolve(&spec.actuation, &spec.bodies).map_err(|m| EnvError::InvalidSpec(format!("{}: {m}", spec.id)))?;
         let act_dim = spec.act_dim();
         Ok(LbmEnv {
             spec,
@@ -207,46 +170,8 @@ impl LbmEnv {
 
     /// Sets the wall velocities for physical actuation `a` (units of U or U/D).
     fn actuate(&mut self, a: &[f64]) {
-        let n_bodies = self.spec.bodies.len();
-        let mut pair: [f64; 2];
-        for b in 0..n_bodies {
-            let motion = match &self.spec.actuation {
-                ActuationSpec::ZnmfJets { body, .. } if *body == b => {
-                    // One action: blowing at the first jet, the same suction at the second.
-                    WallMotion {
-                        jets: &self.jets,
-                        amplitudes: &[a[0], -a[0]],
-                        rotation: None,
-                    }
-                }
-                ActuationSpec::ZnmfJetsPerBody { bodies, .. } => match bodies.iter().position(|&i| i == b) {
-                    // Jets 2k and 2k + 1 belong to the k-th listed body: blowing and suction.
-                    Some(k) => {
-                        pair = [a[k], -a[k]];
-                        WallMotion {
-                            jets: &self.jets[2 * k..2 * k + 2],
-                            amplitudes: &pair,
-                            rotation: None,
-                        }
-                    }
-                    None => WallMotion::default(),
-                },
-                ActuationSpec::Jets { body, .. } if *body == b => WallMotion {
-                    jets: &self.jets,
-                    amplitudes: a,
-                    rotation: None,
-                },
-                ActuationSpec::Rotation { bodies, .. } => match bodies.iter().position(|&i| i == b) {
-                    Some(k) => WallMotion {
-                        jets: &[],
-                        amplitudes: &[],
-                        rotation: Some((self.centers[k], a[k])),
-                    },
-                    None => WallMotion::default(),
-                },
-                _ => WallMotion::default(),
-            };
-            apply(&mut self.solver, b, &motion, &self.units);
+        for b in 0..self.spec.bodies.len() {
+            apply(&mut self.solver, b, &self.spec.actuation, &self.jets, &self.centers, a, &self.units);
         }
         if let (ActuationSpec::InletTemperature { .. }, Some(th)) = (&self.spec.actuation, &mut self.thermal) {
             // Finite and within the spec's range by construction (see `step`).

@@ -21,12 +21,15 @@ use crate::flow::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, Resoluti
 
 pub const REYNOLDS: [u32; 4] = [30, 75, 100, 150];
 
-/// The fluidic pinball family: rotation, then jets, each over [`REYNOLDS`].
+/// The fluidic pinball family: rotation, then jets, each over [`REYNOLDS`], then rotation in 3D
+/// (`Pinball_3D_Re{...}`, `super::cylinder::in_3d`: span 4 D, one segment).
 pub struct Pinball;
 
 impl super::family::Family for Pinball {
     fn specs(&self) -> Vec<super::family::Spec> {
-        super::registry::lbm(REYNOLDS.map(rotary).into_iter().chain(REYNOLDS.map(jets)))
+        let mut specs = super::registry::lbm(REYNOLDS.map(rotary).into_iter().chain(REYNOLDS.map(jets)));
+        specs.extend(super::registry::lbm3(REYNOLDS.map(|re| super::cylinder::in_3d(rotary(re)))));
+        specs
     }
 }
 

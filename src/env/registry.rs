@@ -2,7 +2,7 @@
 
 use super::family::{Family, Spec};
 use super::spec::EnvSpec;
-use super::{calibrate, cavity, channel, cylinder, kolmogorov, naca, pinball, pipe, square, EnvInputError};
+use super::{calibrate, cavity, channel, cube, cylinder, kolmogorov, naca, pinball, pipe, sphere, square, EnvInputError};
 
 /// The families, in listing order. A new family is one file implementing [`Family`] and one
 /// line here.
@@ -13,6 +13,8 @@ pub const FAMILIES: &[&dyn Family] = &[
     &cavity::Cavity,
     &naca::Naca,
     &pipe::Pipe,
+    &sphere::Sphere,
+    &cube::Cube,
     &kolmogorov::KolmogorovFlows,
     &channel::Channels,
 ];
@@ -60,6 +62,20 @@ pub(super) fn lbm(specs: impl IntoIterator<Item = EnvSpec>) -> Vec<Spec> {
         .into_iter()
         .map(|mut s| {
             calibrate::attach(&mut s, calibrate::table());
+            Spec::new(s)
+        })
+        .collect()
+}
+
+/// 3D lattice-Boltzmann specs as registry entries, with the committed observation statistics of
+/// the default level attached.
+pub(super) fn lbm3(specs: impl IntoIterator<Item = super::spec3::Env3Spec>) -> Vec<Spec> {
+    specs
+        .into_iter()
+        .map(|mut s| {
+            if let Some(n) = super::lbm_env3::committed_normalization(&s, crate::flow::Level::Default) {
+                s.normalization = n;
+            }
             Spec::new(s)
         })
         .collect()

@@ -22,12 +22,14 @@ use crate::flow::GeometrySpec;
 
 pub const REYNOLDS: [u32; 3] = [200, 1000, 3900];
 
-/// The square cylinder family over [`REYNOLDS`].
+/// The square cylinder family over [`REYNOLDS`], in 2D and in 3D (`super::cylinder::in_3d`).
 pub struct Square;
 
 impl super::family::Family for Square {
     fn specs(&self) -> Vec<super::family::Spec> {
-        super::registry::lbm(REYNOLDS.map(square))
+        let mut specs = super::registry::lbm(REYNOLDS.map(square));
+        specs.extend(super::registry::lbm3(REYNOLDS.map(|re| super::cylinder::in_3d(square(re)))));
+        specs
     }
 }
 

@@ -201,6 +201,21 @@ impl LbmFlow3 {
     pub fn rho_u(&self, p: [usize; 3]) -> (f64, [f64; 3]) {
         each!(self, s => s.rho_u(p))
     }
+
+    /// Mass body `b`'s moving walls inject per step (lattice units; see `Lbm3::wall_mass_source`).
+    pub fn wall_mass_source(&self, b: usize) -> f64 {
+        each!(self, s => s.wall_mass_source(b))
+    }
+
+    /// The populations (the state a developed-flow cache keeps).
+    pub fn populations(&self) -> &[f32] {
+        each!(self, s => s.populations_raw())
+    }
+
+    /// Restores populations of a solver of the same set-up and level, and the step count.
+    pub fn set_populations(&mut self, f: &[f32], time: u64) -> Result<(), LbmError> {
+        each!(self, s => s.set_populations(f, time))
+    }
 }
 
 impl FlowSetup {

@@ -544,6 +544,21 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         }
     }
 
+    /// Mass the moving-wall terms of body `b`'s links inject per step (lattice units): over its
+    /// links `6 w_k c_k . u_w`, divided by `2 q` where the interpolated bounce-back does
+    /// (`q >= 1/2`). Zero for a wall moving along itself; a jet's outflow otherwise.
+    pub fn wall_mass_source(&self, b: usize) -> f64 {
+        let mut m = 0.0f64;
+        for l in self.plan.links.iter().filter(|l| l.body as usize == b) {
+            let k = l.k as usize;
+            let c = L::C_REF[k];
+            let cu: f64 = (0..3).map(|a| c[a] as f64 * l.uw[a] as f64).sum();
+            let term = 6.0 * L::W_REF[k] as f64 * cu;
+            m += if l.q < 0.5 { term } else { term / (2.0 * l.q as f64) };
+        }
+        m
+    }
+
     /// Density and velocity at the physical point `x`, trilinear between the eight nodes
     /// around it (wrapping along periodic axes). Solid nodes count as resting fluid.
     pub fn probe(&self, x: [f64; 3]) -> Result<(f64, [f64; 3]), LbmError> {
@@ -601,6 +616,20 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     /// The populations (for checkpoints and tests).
     pub fn populations_raw(&self) -> &[f32] {
         &self.f
+    }
+
+    /// Restores populations taken with [`Self::populations_raw`] from a solver of the same
+    /// configuration, and the step count `time`.
+    pub fn set_populations(&mut self, f: &[f32], time: u64) -> Result<(), LbmError> {
+        if f.len() != self.f.len() {
+            return Err(LbmError::Config {
+                field: "populations",
+                message: format!("expected {} values, got {}", self.f.len(), f.len()),
+            });
+        }
+        self.f.copy_from_slice(f);
+        self.time = time;
+        Ok(())
     }
 
     /// Fills the spare array with NaN (tests: results must not depend on its contents).

@@ -1,0 +1,226 @@
+//! The 3D lattice-Boltzmann environments (`*_3D_*`): Gymnasium's contract over every registered
+//! ID at the coarse level (the real coarse grids; spin-up and control interval shortened so the
+//! suite stays short; `hgym eval --policy random` runs full episodes), per-segment forces that
+//! add up to the body's, one agent per segment for multi-agent training, and bitwise-repeatable
+//! trajectories.
+
+use hgym::env::spec::ActuationSpec;
+use hgym::env::spec3::{Actuation3Spec, Env3Spec};
+use hgym::env::{registry, LbmEnv3};
+use hgym::flow::Level;
+use hgym_agents::multi::pseudo_envs;
+use hgym_agents::{check_env, Env, EnvError};
+
+/// `spec` with a short spin-up and control interval, `actions` per episode.
+fn short(spec: &Env3Spec, actions: usize) -> Env3Spec {
+    let mut s = spec.clone();
+    s.spin_up = 0.5;
+    s.control_interval = 0.02;
+    s.episode_actions = actions;
+    s
+}
+
+fn specs3() -> Vec<Env3Spec> {
+    registry::all().iter().filter_map(|s| s.downcast::<Env3Spec>().cloned()).collect()
+}
+
+#[test]
+fn every_3d_id_keeps_the_env_contract_at_coarse() {
+    let specs = specs3();
+    for family in ["cylinder", "rotary_cylinder", "pinball", "square_cylinder", "sphere", "cube"] {
+        assert!(specs.iter().any(|s| s.family == family), "no 3D {family} ID registered");
+    }
+    for spec in specs {
+        let id = spec.id.clone();
+        let spec = short(&spec, 3);
+        let mut env = LbmEnv3::new(spec.clone(), Level::Coarse, None).unwrap_or_else(|e| panic!("{id}: {e}"));
+        let violations = check_env(&mut env, spec.episode_actions, 7);
+        assert!(violations.is_empty(), "{id}: {violations:#?}");
+        assert_eq!(env.observation_space().dim(), spec.obs_dim(), "{id}");
+        let act = env.action_space().dim();
+        env.reset(3).unwrap();
+        for (k, a) in [1.7, -0.4, 0.3].iter().enumerate() {
+            let r = env.step(&vec![*a; act]).unwrap_or_else(|e| panic!("{id}: step {k}: {e}"));
+            assert!(!r.terminated, "{id}: terminated at step {k}: {:?}", r.info.text("reason"));
+            assert!(r.obs.iter().all(|v| v.is_finite()), "{id}: non-finite observation");
+            let clipped = if a.abs() > 1.0 { act as f64 } else { 0.0 };
+            assert_eq!(r.info.get("clipped"), Some(clipped), "{id}: clipping not counted");
+            for key in ["t", "C_D", "C_L", "C_S", "C_D_0", "C_D_seg0", "actuation_0"] {
+                assert!(r.info.get(key).is_some_and(|v| v.is_finite()), "{id}: info lacks {key}");
+            }
+            assert!(r.reward.is_finite() && r.reward < 0.0, "{id}: reward {}", r.reward);
+        }
+        assert!(matches!(env.step(&vec![0.0; act]), Err(EnvError::NeedsReset)), "{id}");
+        println!("{id}: contract ok, {} obs, {act} actions", spec.obs_dim());
+    }
+}
+
+/// The segments of a span split the body's force: the mean of the segments' coefficients (each
+/// over its share of the area) is the body's; each segment is one agent seeing its own probes
+/// and setting its own jet pair, and the pseudo-environments step the one flow together.
+#[test]
+fn segments_split_forces_and_agents() {
+    let spec = short(
+        &registry::lookup("Cylinder_3D_Re1000")
+            .unwrap()
+            .downcast::<Env3Spec>()
+            .unwrap()
+            .clone(),
+        4,
+    );
+    let segments = spec.span.segments;
+    assert_eq!(segments, 4);
+    let mut env = LbmEnv3::new(spec.clone(), Level::Coarse, None).unwrap();
+    env.reset(0).unwrap();
+    let r = env.step(&[0.8, -0.3, 0.0, 1.0]).unwrap();
+    let c_d = r.info.get("C_D").unwrap();
+    let c_l = r.info.get("C_L").unwrap();
+    let mean = |key: &str| (0..segments).map(|s| r.info.get(&format!("{key}_seg{s}")).unwrap()).sum::<f64>() / segments as f64;
+    println!(
+        "C_D {c_d:.6} vs segment mean {:.6}; C_L {c_l:.6} vs {:.6}",
+        mean("C_D"),
+        mean("C_L")
+    );
+    assert!((mean("C_D") - c_d).abs() < 1e-9 * c_d.abs().max(1.0));
+    assert!((mean("C_L") - c_l).abs() < 1e-9);
+    let rewards = env.agent_rewards();
+    assert_eq!(rewards.len(), segments);
+    assert!(rewards.iter().all(|r| r.is_finite() && *r < 0.0), "{rewards:?}");
+
+    let agents = env.agents().expect("a segmented span declares agents");
+    assert_eq!(agents.len(), segments);
+    let per = 4 * spec.probes.len();
+    for s in 0..segments {
+        assert_eq!(agents.act[s], vec![s], "agent {s} sets its segment's jet pair");
+        assert_eq!(
+            agents.obs[s],
+            (s * per..(s + 1) * per).collect::<Vec<_>>(),
+            "agent {s} sees its segment's probes"
+        );
+    }
+    let mut pseudo = pseudo_envs(env).unwrap();
+    assert_eq!(pseudo.len(), segments);
+    for (k, p) in pseudo.iter_mut().enumerate() {
+        assert_eq!(p.action_space().dim(), 1);
+        assert_eq!(p.observation_space().dim(), per);
+        p.submit_reset(5 + k as u64).unwrap();
+    }
+    for p in pseudo.iter_mut() {
+        let (obs, _) = p.reset(0).unwrap();
+        assert_eq!(obs.len(), per);
+    }
+    for p in pseudo.iter_mut() {
+        p.submit(&[0.5]).unwrap();
+    }
+    for p in pseudo.iter_mut() {
+        let r = p.step(&[0.5]).unwrap();
+        assert!(r.reward.is_finite() && !r.terminated);
+    }
+
+    // A body without segments (the sphere's surface jets) has no agents.
+    let sphere = registry::lookup("Sphere_3D_Re300").unwrap().downcast::<Env3Spec>().unwrap().clone();
+    let env = LbmEnv3::new(short(&sphere, 2), Level::Coarse, None).unwrap();
+    assert!(env.agents().is_none());
+}
+
+/// Turning segment 0 alone changes its lift far more than that of the segment across the span:
+/// the actuators act on their own segment.
+#[test]
+fn a_segment_actuator_acts_on_its_own_segment() {
+    let spec = short(
+        &registry::lookup("RotaryCylinder_3D_Re1000")
+            .unwrap()
+            .downcast::<Env3Spec>()
+            .unwrap()
+            .clone(),
+        8,
+    );
+    let run = |action: [f64; 4]| {
+        let mut env = LbmEnv3::new(spec.clone(), Level::Coarse, None).unwrap();
+        env.reset(0).unwrap();
+        let mut r = None;
+        for _ in 0..8 {
+            r = Some(env.step(&action).unwrap());
+        }
+        let r = r.unwrap();
+        (0..4).map(|s| r.info.get(&format!("C_L_seg{s}")).unwrap()).collect::<Vec<_>>()
+    };
+    let rest = run([0.0; 4]);
+    let turn = run([1.0, 0.0, 0.0, 0.0]);
+    let change: Vec<f64> = rest.iter().zip(&turn).map(|(a, b)| (b - a).abs()).collect();
+    println!("|change of C_L| per segment: {change:?}");
+    assert!(change[0] > 10.0 * change[2], "segment 0 {} vs segment 2 {}", change[0], change[2]);
+}
+
+/// Same seed and actions in two separately built environments: the same trajectory, bitwise.
+#[test]
+fn same_seed_same_actions_same_trajectory() {
+    let spec = short(
+        &registry::lookup("Pinball_3D_Re30").unwrap().downcast::<Env3Spec>().unwrap().clone(),
+        3,
+    );
+    let run = || {
+        let mut env = LbmEnv3::new(spec.clone(), Level::Coarse, None).unwrap();
+        let (mut obs, _) = env.reset(11).unwrap();
+        for k in 0..3 {
+            obs.extend(env.step(&[0.5, -0.2 * k as f64, 0.1]).unwrap().obs);
+        }
+        obs
+    };
+    assert_eq!(run(), run());
+}
+
+/// Every surface jet (sphere, cube) reaches wall links at the coarse level: alone at its bound
+/// it injects mass. A zero-net-mass-flux pair of a segment injects none; a segment's section
+/// jets (the square's) inject mass of their own.
+#[test]
+fn every_3d_jet_reaches_the_wall_at_coarse() {
+    for spec in specs3() {
+        let id = spec.id.clone();
+        let znmf = matches!(
+            &spec.actuation,
+            Actuation3Spec::Segments {
+                actuator: ActuationSpec::ZnmfJets { .. }
+            }
+        );
+        if !(znmf
+            || matches!(
+                &spec.actuation,
+                Actuation3Spec::SurfaceJets { .. }
+                    | Actuation3Spec::Segments {
+                        actuator: ActuationSpec::Jets { .. }
+                    }
+            ))
+        {
+            continue;
+        }
+        let mut env = LbmEnv3::new(short(&spec, 1), Level::Coarse, None).unwrap();
+        let m = env.actuator_mass_sources(1.0);
+        println!("{id}: mass per step by each action at its bound {m:?}");
+        if let (true, Actuation3Spec::Segments { actuator }) = (znmf, &spec.actuation) {
+            // The pair's first jet alone.
+            let (jets, _) = hgym::env::actuation::resolve(actuator, &spec.bodies).unwrap();
+            let mut one = short(&spec, 1);
+            one.actuation = Actuation3Spec::Segments {
+                actuator: ActuationSpec::Jets {
+                    body: 0,
+                    jets: jets[..1].to_vec(),
+                    max_velocity: 1.0,
+                },
+            };
+            let alone = LbmEnv3::new(one, Level::Coarse, None).unwrap().actuator_mass_sources(1.0);
+            println!("{id}: the blowing jet of each pair alone {alone:?}");
+            assert!(
+                alone.iter().all(|v| *v > 1e-5),
+                "{id}: a jet of the pair reaches no wall link at coarse"
+            );
+        }
+        for (k, v) in m.iter().enumerate() {
+            if znmf {
+                assert!(v.abs() < 1e-9, "{id}: jet pair {k} injects net mass {v:e}");
+            } else {
+                assert!(*v > 1e-5, "{id}: jet {k} reaches no wall link at coarse ({v:e})");
+            }
+        }
+    }
+}
