@@ -20,6 +20,15 @@ fn short(spec: &Env3Spec, actions: usize) -> Env3Spec {
     s
 }
 
+/// `spec` with a spin-up and control interval of a few lattice steps: the contract's checks
+/// (spaces, seeding, determinism, truncation) on the real grid at the least cost.
+fn shortest(spec: &Env3Spec, actions: usize) -> Env3Spec {
+    let mut s = short(spec, actions);
+    s.spin_up = 0.1;
+    s.control_interval = 0.005;
+    s
+}
+
 fn specs3() -> Vec<Env3Spec> {
     registry::all().iter().filter_map(|s| s.downcast::<Env3Spec>().cloned()).collect()
 }
@@ -27,13 +36,24 @@ fn specs3() -> Vec<Env3Spec> {
 #[test]
 fn every_3d_id_keeps_the_env_contract_at_coarse() {
     let specs = specs3();
-    for family in ["cylinder", "rotary_cylinder", "pinball", "square_cylinder", "sphere", "cube"] {
+    for family in [
+        "cylinder",
+        "rotary_cylinder",
+        "pinball",
+        "square_cylinder",
+        "sphere",
+        "cube",
+        "naca0012",
+        "cavity",
+    ] {
         assert!(specs.iter().any(|s| s.family == family), "no 3D {family} ID registered");
     }
     for spec in specs {
         let id = spec.id.clone();
-        let spec = short(&spec, 3);
+        let spec = shortest(&spec, 3);
+        let start = std::time::Instant::now();
         let mut env = LbmEnv3::new(spec.clone(), Level::Coarse, None).unwrap_or_else(|e| panic!("{id}: {e}"));
+        let built = start.elapsed().as_secs_f64();
         let violations = check_env(&mut env, spec.episode_actions, 7);
         assert!(violations.is_empty(), "{id}: {violations:#?}");
         assert_eq!(env.observation_space().dim(), spec.obs_dim(), "{id}");
@@ -51,7 +71,11 @@ fn every_3d_id_keeps_the_env_contract_at_coarse() {
             assert!(r.reward.is_finite() && r.reward < 0.0, "{id}: reward {}", r.reward);
         }
         assert!(matches!(env.step(&vec![0.0; act]), Err(EnvError::NeedsReset)), "{id}");
-        println!("{id}: contract ok, {} obs, {act} actions", spec.obs_dim());
+        println!(
+            "{id}: contract ok, {} obs, {act} actions (built in {built:.1} s, checked in {:.1} s)",
+            spec.obs_dim(),
+            start.elapsed().as_secs_f64() - built
+        );
     }
 }
 

@@ -1,5 +1,6 @@
 //! Open cavity family (HydroGym "Open cavity flow"): `Cavity_2D_Re{4200,7500}` with one jet at
-//! the cavity's leading edge, and `Cavity3Jet_2D_Re{...}` with two more jets inside the cavity.
+//! the cavity's leading edge, `Cavity3Jet_2D_Re{...}` with two more jets inside the cavity, and
+//! `Cavity_3D_Re{...}` over a periodic span of 2.25 D (see [`cavity_3d`]).
 //!
 //! Set-up from the paper (after Barbagallo, Sipp & Schmid 2009): a square cavity of depth D = 1
 //! (the reference length) at `x in [0.27, 1.27]`, `y in [0, 1]`, in the domain `[0, 2.5] x [0, 1.5]`;
@@ -56,7 +57,9 @@ pub struct Cavity;
 
 impl super::family::Family for Cavity {
     fn specs(&self) -> Vec<super::family::Spec> {
-        super::registry::lbm(specs())
+        let mut specs = super::registry::lbm(specs());
+        specs.extend(super::registry::lbm3(REYNOLDS.map(cavity_3d)));
+        specs
     }
 }
 
@@ -176,5 +179,42 @@ pub fn cavity_3jet(re: u32) -> EnvSpec {
         re,
         vec![leading_edge_jet(), aft, front],
         format!("2D open square cavity at Re {re}, leading-edge jet and two jets inside the cavity"),
+    )
+}
+
+/// `Cavity_3D_Re{re}`: the 2D set-up over the paper's periodic span `z in [0, 2.25]` (one
+/// segment), actuated by blowing upstream and suction near the downstream edge: the leading-edge
+/// jet and a jet of the same size on the plate 0.03 D downstream of the trailing edge, blowing in
+/// +y, two independent actions (the agent chooses their signs). Levels 40, 64 and 96 cells per D
+/// (the 2D default of 128 would need 24 million nodes).
+pub fn cavity_3d(re: u32) -> super::spec3::Env3Spec {
+    let trailing_edge_jet = Jet {
+        center: [LEADING_EDGE[0] + LENGTH + 0.03, LEADING_EDGE[1]],
+        ..leading_edge_jet()
+    };
+    let base = base(
+        format!("Cavity_2D_Re{re}"),
+        "cavity",
+        re,
+        vec![leading_edge_jet(), trailing_edge_jet],
+        String::new(),
+    );
+    let domain = base.domain.clone();
+    super::spec3::extrude(
+        base,
+        format!("Cavity_3D_Re{re}"),
+        format!("Open square cavity at Re {re} (depth-based), span 2.25 D, jets at the leading and trailing edges"),
+        domain,
+        crate::flow::SpanSpec {
+            z: [0.0, 2.25],
+            boundary: BoundaryKind::Periodic,
+            segments: 1,
+            lattice: Default::default(),
+        },
+        ResolutionSpec {
+            coarse: 40,
+            default: 64,
+            fine: 96,
+        },
     )
 }

@@ -59,9 +59,10 @@ struct Coefficients {
     segment: Vec<[f64; 3]>,
 }
 
+/// The reward of an interval from its forces and the (normalised) observation at its end:
 /// `-sum |C_D| - w sum |(C_L, C_S)|` over `forces` (each body's own, `drag_lift`), or of their sum
-/// (`total_drag_lift`).
-fn force_reward(spec: &RewardSpec, forces: &[[f64; 3]]) -> f64 {
+/// (`total_drag_lift`); `-9 sum obs^2` (`probe_deviation`, as in 2D).
+fn reward(spec: &RewardSpec, forces: &[[f64; 3]], obs: &[f64]) -> f64 {
     let lateral = |f: &[f64; 3]| f[1].hypot(f[2]);
     match spec {
         RewardSpec::DragLift { lift_weight } => forces.iter().map(|f| -f[0].abs() - lift_weight * lateral(f)).sum(),
@@ -69,7 +70,8 @@ fn force_reward(spec: &RewardSpec, forces: &[[f64; 3]]) -> f64 {
             let t = forces.iter().fold([0.0; 3], |t, f| [t[0] + f[0], t[1] + f[1], t[2] + f[2]]);
             -t[0].abs() - lift_weight * lateral(&t)
         }
-        // `Env3Spec::check` admits only the force rewards.
+        RewardSpec::ProbeDeviation => -9.0 * obs.iter().map(|o| o * o).sum::<f64>(),
+        // `Env3Spec::check` admits only the rewards above.
         _ => f64::NAN,
     }
 }
@@ -389,6 +391,8 @@ impl Env for LbmEnv3 {
             }
         };
         let segments = self.spec.segments();
+        let obs = self.observation()?;
+        let per_segment = obs.len() / segments;
         let mut total = [0.0; 3];
         for (b, f) in c.body.iter().enumerate() {
             for (a, name) in ["C_D", "C_L", "C_S"].iter().enumerate() {
@@ -403,10 +407,9 @@ impl Env for LbmEnv3 {
             let of_segment: Vec<[f64; 3]> = (0..c.body.len()).map(|b| c.segment[b * segments + s]).collect();
             info.set(&format!("C_D_seg{s}"), of_segment.iter().map(|f| f[0]).sum());
             info.set(&format!("C_L_seg{s}"), of_segment.iter().map(|f| f[1]).sum());
-            self.segment_rewards[s] = force_reward(&self.spec.reward, &of_segment);
+            self.segment_rewards[s] = reward(&self.spec.reward, &of_segment, &obs[s * per_segment..(s + 1) * per_segment]);
         }
-        let obs = self.observation()?;
-        let reward = force_reward(&self.spec.reward, &c.body);
+        let reward = reward(&self.spec.reward, &c.body, &obs);
         let truncated = self.actions_taken >= self.spec.episode_actions;
         if truncated {
             self.live = false;
@@ -432,7 +435,7 @@ impl Env for LbmEnv3 {
         Agents::new(self.spec.obs_dim(), self.spec.act_dim(), obs, act, self.spec.agent_reward).ok()
     }
 
-    /// Each segment's force reward over the last interval.
+    /// Each segment's reward over the last interval (its forces, or its probes).
     fn agent_rewards(&self) -> Vec<f64> {
         if self.agent_count() == 0 {
             return vec![];

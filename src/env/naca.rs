@@ -1,6 +1,7 @@
 //! NACA 0012 family (HydroGym "Flow around a NACA 0012 airfoil"):
 //! `NACA0012_2D_Re{100,1000}_AoA{20,40}` (wake stabilisation in steady inflow) and
-//! `NACA0012Gust_2D_Re{100,1000}_AoA{20,40}` (transverse gust mitigation).
+//! `NACA0012Gust_2D_Re{100,1000}_AoA{20,40}` (transverse gust mitigation), and
+//! `NACA0012_3D_Re{100,1000}_AoA{20,40}`, the steady ones over a span of 4 c ([`steady_3d`]).
 //!
 //! Set-up: chord c = 1 (the reference length), leading edge at (6.5, 0), rotated nose-up by the
 //! angle of attack about the leading edge, in `[0, 20] x [-6, 6]` (the paper's m-AIA 2D runs use
@@ -44,12 +45,16 @@ pub struct Naca;
 
 impl super::family::Family for Naca {
     fn specs(&self) -> Vec<super::family::Spec> {
-        super::registry::lbm(
+        let mut specs = super::registry::lbm(
             REYNOLDS
                 .iter()
                 .flat_map(|&re| ANGLES.map(|aoa| steady(re, aoa)))
                 .chain(REYNOLDS.iter().flat_map(|&re| ANGLES.iter().filter_map(move |&aoa| gust(re, aoa)))),
-        )
+        );
+        specs.extend(super::registry::lbm3(
+            REYNOLDS.iter().flat_map(|&re| ANGLES.map(|aoa| steady_3d(re, aoa))),
+        ));
+        specs
     }
 }
 pub const ANGLES: [u32; 2] = [20, 40];
@@ -177,6 +182,32 @@ pub fn gust(re: u32, aoa: u32) -> Option<EnvSpec> {
         duration: 2.0,
     });
     Some(s)
+}
+
+/// `NACA0012_3D_Re{re}_AoA{aoa}`: the 2D environment extruded over a periodic span of 4 c (the
+/// paper's for Re <= 1000), the three jets along the whole span (one segment), in the 2D
+/// environment's x-y box ([0, 20] x [-6, 6] c; the paper's 3D box is 32 x 16 c). Levels 16, 32
+/// and 48 cells per chord (the 2D default of 64 would need 250 million nodes).
+pub fn steady_3d(re: u32, aoa: u32) -> super::spec3::Env3Spec {
+    let base = steady(re, aoa);
+    let domain = base.domain.clone();
+    super::spec3::extrude(
+        base,
+        format!("NACA0012_3D_Re{re}_AoA{aoa}"),
+        format!("NACA 0012 at Re {re} (chord), {aoa} degrees, span 4 c, three leading-edge jets along the span"),
+        domain,
+        crate::flow::SpanSpec {
+            z: [-2.0, 2.0],
+            boundary: crate::flow::BoundaryKind::Periodic,
+            segments: 1,
+            lattice: Default::default(),
+        },
+        ResolutionSpec {
+            coarse: 16,
+            default: 32,
+            fine: 48,
+        },
+    )
 }
 
 #[cfg(test)]

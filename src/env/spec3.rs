@@ -15,7 +15,7 @@ use hgym_agents::multi::AgentReward;
 use hgym_solvers::lbm::Collision;
 
 use super::actuation::Ramp;
-use super::spec::{ActuationSpec, Normalization, RewardSpec};
+use super::spec::{ActuationSpec, Normalization, RewardSpec, SpongeSpec};
 use crate::flow::{BoundarySpec, DomainSpec, FlowSetup, GeometrySpec, InletSpec, ResolutionSpec, SpanSpec};
 
 /// The actuators of a 3D environment; actions in `[-1, 1]` are scaled by the bound given here.
@@ -164,7 +164,8 @@ pub struct Env3Spec {
     /// Probe positions `[x, y]`, observed in the mid-plane of every spanwise segment.
     #[serde(deserialize_with = "crate::flow::pairs")]
     pub probes: Vec<[f64; 2]>,
-    /// `drag_lift` or `total_drag_lift`, with the lift the lateral force `(C_L, C_S)`'s magnitude.
+    /// `drag_lift` or `total_drag_lift`, with the lift the lateral force `(C_L, C_S)`'s magnitude,
+    /// or `probe_deviation`.
     pub reward: RewardSpec,
     /// The reward each agent of multi-agent training (one per segment) learns from: the
     /// environment's, or its own segment's `-sum_b |C_D,b,s| - w sum_b |(C_L, C_S)_b,s|`.
@@ -177,6 +178,9 @@ pub struct Env3Spec {
     pub spin_up: f64,
     #[serde(default)]
     pub normalization: Normalization,
+    /// An absorbing layer along one x or y face (the open cavity's top).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sponge: Option<Box<SpongeSpec>>,
 }
 
 impl Env3Spec {
@@ -219,7 +223,7 @@ impl Env3Spec {
             collision: self.collision,
             smagorinsky: self.smagorinsky,
             resolution: self.resolution.clone(),
-            sponges: vec![],
+            sponges: self.sponge.iter().map(|s| (**s).clone()).collect(),
             refinement: None,
             span: Some(self.span.clone()),
         }
@@ -260,8 +264,11 @@ impl Env3Spec {
         if !(b.is_finite() && b > 0.0) {
             return Err(format!("actuation: the bound must be a positive number, got {b}"));
         }
-        if !matches!(self.reward, RewardSpec::DragLift { .. } | RewardSpec::TotalDragLift { .. }) {
-            return Err("reward: 3D flows reward forces: use drag_lift or total_drag_lift".into());
+        if !matches!(
+            self.reward,
+            RewardSpec::DragLift { .. } | RewardSpec::TotalDragLift { .. } | RewardSpec::ProbeDeviation
+        ) {
+            return Err("reward: 3D flows reward forces or probe deviations: use drag_lift, total_drag_lift or probe_deviation".into());
         }
         Ok(())
     }
@@ -343,5 +350,6 @@ pub fn extrude(
         episode_actions: base.episode_actions,
         spin_up: base.spin_up,
         normalization: Normalization::default(),
+        sponge: base.sponge,
     }
 }

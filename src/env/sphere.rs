@@ -97,6 +97,7 @@ pub(super) fn in_box(
         episode_actions: 200,
         spin_up: 60.0,
         normalization: Normalization::default(),
+        sponge: None,
     }
 }
 

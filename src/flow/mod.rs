@@ -237,9 +237,6 @@ impl FlowSetup {
                 if self.refinement.is_some() {
                     return Err(bad("refinement", "3D flows run on one uniform grid; remove the refinement regions"));
                 }
-                if !self.sponges.is_empty() {
-                    return Err(bad("sponge", "3D flows have no absorbing layers yet; remove the sponge layers"));
-                }
                 if self.inlet.profile != Profile::Uniform || self.inlet.characteristic_time > 0.0 {
                     return Err(bad(
                         "inlet",

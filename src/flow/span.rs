@@ -8,10 +8,10 @@
 use serde::{Deserialize, Serialize};
 
 use hgym_solvers::geometry::{Cuboid, Extruded, Solid, Sphere};
-use hgym_solvers::lbm::d3::{D3Config, D3q19, D3q27, Face, Faces, Grid3, Lattice3, Lbm3};
+use hgym_solvers::lbm::d3::{D3Config, D3q19, D3q27, Face, Faces, Grid3, Lattice3, Lbm3, Sponge3};
 use hgym_solvers::lbm::LbmError;
 
-use super::{BoundaryKind, FlowError, FlowPlan, FlowSetup, GeometrySpec};
+use super::{BoundaryKind, EdgeName, FlowError, FlowPlan, FlowSetup, GeometrySpec};
 
 /// The 3D velocity set of a flow.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
@@ -220,7 +220,8 @@ impl LbmFlow3 {
 
 impl FlowSetup {
     /// Builds the 3D solver at `plan` (a set-up with a span): faces from the boundaries and the
-    /// span, the inlet's uniform velocity, collision, subgrid viscosity, the bodies as solids.
+    /// span, the inlet's uniform velocity, collision, subgrid viscosity, absorbing layers on the
+    /// x and y faces, the bodies as solids.
     /// The fluid starts at rest; callers set their initial state.
     pub fn build3(&self, plan: &FlowPlan) -> Result<LbmFlow3, FlowError> {
         let Some(span) = &self.span else {
@@ -260,6 +261,25 @@ impl FlowSetup {
         cfg.collision = plan.collision;
         cfg.smagorinsky = self.smagorinsky;
         cfg.check_interval = super::build::CHECK_INTERVAL;
+        cfg.sponges = self
+            .sponges
+            .iter()
+            .map(|sp| {
+                let layer = sp.lattice(plan.units.cells_per_length, self.lattice_velocity);
+                Sponge3 {
+                    face: match sp.edge {
+                        EdgeName::West => 0,
+                        EdgeName::East => 1,
+                        EdgeName::South => 2,
+                        EdgeName::North => 3,
+                    },
+                    width: layer.width,
+                    strength: layer.strength,
+                    rho: layer.rho,
+                    u: [layer.u[0], layer.u[1], 0.0],
+                }
+            })
+            .collect();
         let solids: Vec<Box<dyn Solid>> = self.bodies.iter().map(GeometrySpec::solid).collect();
         let bodies: Vec<&dyn Solid> = solids.iter().map(|b| b.as_ref()).collect();
         let built = match span.lattice {

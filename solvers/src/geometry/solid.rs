@@ -26,6 +26,12 @@ pub trait Solid: Send + Sync + std::fmt::Debug {
         }
         0.5 * (lo + hi)
     }
+
+    /// Whether `sdf` is the same at every z (a section extruded along the span), so that one
+    /// plane of a grid describes them all.
+    fn z_invariant(&self) -> bool {
+        false
+    }
 }
 
 /// Sphere of `radius` around `center`: `phi(p) = |p - c| - r`.
@@ -71,6 +77,10 @@ impl<S: Shape> Solid for Extruded<S> {
 
     fn wall_fraction(&self, a: [f64; 3], b: [f64; 3]) -> f64 {
         self.0.wall_fraction([a[0], a[1]], [b[0], b[1]])
+    }
+
+    fn z_invariant(&self) -> bool {
+        true
     }
 }
 

@@ -1,7 +1,7 @@
 //! Lattice Boltzmann in three dimensions: D3Q19 and D3Q27 on a box whose faces are periodic,
 //! walls, free-slip, velocity inlets or outlets, with immersed bodies (interpolated bounce-back
 //! from signed distances, moving walls, momentum-exchange forces per body and per spanwise
-//! segment) and trilinear probes.
+//! segment), absorbing layers on any face and trilinear probes.
 //!
 //! Same habits as the 2D kernel: shifted FP32 storage, structure of arrays (`f[((z Q + i) ny +
 //! y) nx + x]`), one fused pull-scheme stream-collide pass per step over two arrays, rayon over
@@ -17,7 +17,9 @@ mod kernel;
 pub mod lattice;
 mod sides;
 mod solver;
+mod sponge;
 
 pub use lattice::{D3q19, D3q27, Lattice3};
 pub use sides::{Face, Faces};
 pub use solver::{D3Config, Grid3, Lbm3};
+pub use sponge::Sponge3;

@@ -10,7 +10,8 @@ use super::super::solver::STREAM_STORES_ABOVE_BYTES;
 use super::collision::{collide, equilibrium, moments};
 use super::kernel::{bouzidi, gather, index, plane, Ctx, Link, Special, PAD};
 use super::lattice::Lattice3;
-use super::sides::Faces;
+use super::sides::{Face, Faces};
+use super::sponge::{apply_plane, Sponge3, Sponge3Plan};
 use crate::geometry::Solid;
 
 /// Where node `(i, j, k)` sits in physical space: `origin + (i, j, k) dx`.
@@ -55,6 +56,8 @@ pub struct D3Config {
     /// Non-temporal stores for the bulk: `None` decides by size (as in 2D,
     /// [`STREAM_STORES_ABOVE_BYTES`]). A performance knob only: results are bitwise the same.
     pub stream_stores: Option<bool>,
+    /// Absorbing layers, applied after each collision.
+    pub sponges: Vec<Sponge3>,
 }
 
 impl D3Config {
@@ -73,6 +76,7 @@ impl D3Config {
             rho_bounds: [0.5, 2.0],
             u_max: 0.5,
             stream_stores: None,
+            sponges: vec![],
         }
     }
 }
@@ -113,6 +117,7 @@ pub struct Lbm3<const Q: usize, L: Lattice3<Q>> {
     /// Force on each (body, segment), `[b * segments + s]`, during the last step.
     segment_forces: Vec<[f64; 3]>,
     body_forces: Vec<[f64; 3]>,
+    sponges: Vec<Sponge3Plan>,
     time: u64,
     _lattice: std::marker::PhantomData<L>,
 }
@@ -154,6 +159,15 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         let config = |field: &'static str, message: String| LbmError::Config { field, message };
         if nx < 1 || ny < 1 || nz < 1 {
             return Err(config("n", format!("every axis needs at least one node, got {:?}", cfg.n)));
+        }
+        for sp in &cfg.sponges {
+            let a = sp.face / 2;
+            if sp.face >= 6 || sp.width == 0 || sp.width > cfg.n[a.min(2)] || !(sp.strength > 0.0 && sp.strength <= 1.0) {
+                return Err(config(
+                    "sponges",
+                    format!("a layer needs a face 0-5, a width of 1 to the nodes along its axis and a strength in (0, 1]; got {sp:?}"),
+                ));
+            }
         }
         let cells = nx * ny * nz;
         if cells >= u32::MAX as usize {
@@ -205,12 +219,17 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         let pos = |p: [usize; 3]| cfg.grid.position(p);
         let inside = |x: [f64; 3]| bodies.iter().position(|b| b.sdf(x) < 0.0);
         let mut solid = vec![false; cells];
-        for z in 0..nz {
+        // Bodies that are the same at every z: the first plane, copied along the span.
+        let planes = if bodies.iter().all(|b| b.z_invariant()) { 1 } else { nz };
+        for z in 0..planes {
             for y in 0..ny {
                 for x in 0..nx {
                     solid[node([x, y, z])] = inside(pos([x, y, z])).is_some();
                 }
             }
+        }
+        for z in planes..nz {
+            solid.copy_within(0..nx * ny, z * nx * ny);
         }
         // The source `p - c` of a pull, wrapped along periodic axes; `None` outside the box.
         let source = |p: [usize; 3], c: [i32; 3]| -> Option<[usize; 3]> {
@@ -277,6 +296,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         }
         row_start.push(specials.len() as u32);
         Ok(Lbm3 {
+            sponges: cfg.sponges.iter().map(Sponge3Plan::new::<Q, L>).collect(),
             relax: Relax::new(cfg.tau, cfg.smagorinsky),
             velocity_scale: 1.0,
             f: AlignedVec::zeros_padded(cells * Q, PAD),
@@ -413,10 +433,10 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         let ctx = ctx::<Q>(&self.cfg, &self.plan, self.relax, self.velocity_scale);
         let (src, src_ext) = (&self.f[..], self.f.padded());
         let plane_len = Q * self.cfg.n[0] * self.cfg.n[1];
-        self.f_next
-            .par_chunks_mut(plane_len)
-            .enumerate()
-            .for_each(|(z, out)| kernel(&ctx, src, src_ext, z, out));
+        self.f_next.par_chunks_mut(plane_len).enumerate().for_each(|(z, out)| {
+            kernel(&ctx, src, src_ext, z, out);
+            apply_plane(&self.sponges, out, z, self.cfg.n, &self.plan.solid);
+        });
         Self::link_forces(&ctx, src, self.cfg.segments, &mut self.segment_forces, &mut self.body_forces);
         std::mem::swap(&mut self.f, &mut self.f_next);
         self.finish_step()
@@ -455,6 +475,9 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         let (mut segment, mut body) = (vec![[0.0; 3]; self.bodies * self.cfg.segments], vec![[0.0; 3]; self.bodies]);
         Self::link_forces(&ctx, &self.f, self.cfg.segments, &mut segment, &mut body);
         (self.segment_forces, self.body_forces) = (segment, body);
+        for (z, plane) in next.chunks_mut(Q * nx * ny).enumerate() {
+            apply_plane(&self.sponges, plane, z, self.cfg.n, &self.plan.solid);
+        }
         self.f_next.copy_from_slice(&next);
         std::mem::swap(&mut self.f, &mut self.f_next);
         self.finish_step()
@@ -522,6 +545,22 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                 at,
             }),
             None => Ok(()),
+        }
+    }
+
+    /// Sets face `face` (`2 a` the low end of axis `a`, `2 a + 1` the high end) to a velocity
+    /// face of lattice velocity `u` from the next step on (a gust at the inlet); refused for a
+    /// face that is not a velocity face.
+    pub fn set_face_velocity(&mut self, face: usize, u: [f64; 3]) -> Result<(), LbmError> {
+        match self.cfg.faces.0.get(face) {
+            Some(Face::Velocity(_)) => {
+                self.cfg.faces.0[face] = Face::Velocity(u.map(|v| v as f32));
+                Ok(())
+            }
+            other => Err(LbmError::Config {
+                field: "faces",
+                message: format!("face {face} is {}, not a velocity face", other.map_or("absent", Face::name)),
+            }),
         }
     }
 
