@@ -248,3 +248,44 @@ fn every_3d_jet_reaches_the_wall_at_coarse() {
         }
     }
 }
+
+/// The 3D gust enters through the inlet with the paper's 1 - cos shape, uniformly across the
+/// span: the transverse velocity half a cell inside the inlet peaks at G at mid-gust, equal at two
+/// spanwise positions, and is gone after it (coarse grid over a short span, gust moved to the
+/// start of the episode).
+#[test]
+fn a_3d_gust_enters_through_the_inlet_across_the_span() {
+    let mut spec = hgym::env::naca::steady_3d(1000, 20);
+    spec.span.z = [-0.25, 0.25];
+    spec.spin_up = 0.5;
+    spec.episode_actions = 35;
+    spec.gust = hgym::env::naca::gust(1000, 20).unwrap().gust;
+    let g = spec.gust.as_mut().unwrap();
+    g.start = 0.0;
+    let g = g.clone();
+    let mut env = LbmEnv3::new(spec.clone(), Level::Coarse, None).unwrap();
+    env.reset(0).unwrap();
+    let (mut v, mut spread) = (vec![], 0.0f64);
+    for _ in 0..spec.episode_actions {
+        let r = env.step(&[0.0; 3]).unwrap();
+        assert!(!r.terminated, "{:?}", r.info.text("reason"));
+        let at = |z: f64| env.units().velocity(env.solver().probe([0.05, 0.0, z]).unwrap().1[1]);
+        spread = spread.max((at(-0.2) - at(0.2)).abs());
+        v.push(at(0.0));
+    }
+    let dt = spec.control_interval;
+    let (k, peak) = v
+        .iter()
+        .enumerate()
+        .fold((0, f64::MIN), |(kb, vb), (k, x)| if *x > vb { (k, *x) } else { (kb, vb) });
+    let t_peak = (k + 1) as f64 * dt;
+    println!(
+        "inlet gust peak {peak:.4} at t = {t_peak:.2} (G = {}), spanwise spread {spread:.2e}",
+        g.ratio
+    );
+    assert!((peak - g.ratio).abs() < 0.05 * g.ratio, "peak {peak}");
+    assert!((t_peak - (g.start + 0.5 * g.duration)).abs() <= 0.3, "peak at t = {t_peak}");
+    assert!(spread < 1e-6 * g.ratio, "the gust varies across the span by {spread}");
+    let after = ((g.start + g.duration + 0.5) / dt) as usize;
+    assert!(v[after..].iter().all(|x| x.abs() < 0.01), "transverse velocity left after the gust");
+}

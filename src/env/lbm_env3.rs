@@ -61,7 +61,8 @@ struct Coefficients {
 
 /// The reward of an interval from its forces and the (normalised) observation at its end:
 /// `-sum |C_D| - w sum |(C_L, C_S)|` over `forces` (each body's own, `drag_lift`), or of their sum
-/// (`total_drag_lift`); `-9 sum obs^2` (`probe_deviation`, as in 2D).
+/// (`total_drag_lift`); `-|C_L - C_L,ref| - w |C_D - C_D,ref|` of their sum (`gust_loads`);
+/// `-9 sum obs^2` (`probe_deviation`); as in 2D.
 fn reward(spec: &RewardSpec, forces: &[[f64; 3]], obs: &[f64]) -> f64 {
     let lateral = |f: &[f64; 3]| f[1].hypot(f[2]);
     match spec {
@@ -71,6 +72,14 @@ fn reward(spec: &RewardSpec, forces: &[[f64; 3]], obs: &[f64]) -> f64 {
             -t[0].abs() - lift_weight * lateral(&t)
         }
         RewardSpec::ProbeDeviation => -9.0 * obs.iter().map(|o| o * o).sum::<f64>(),
+        RewardSpec::GustLoads {
+            c_l_ref,
+            c_d_ref,
+            drag_weight,
+        } => {
+            let (c_d, c_l) = forces.iter().fold((0.0, 0.0), |(d, l), f| (d + f[0], l + f[1]));
+            -(c_l - c_l_ref).abs() - drag_weight * (c_d - c_d_ref).abs()
+        }
         // `Env3Spec::check` admits only the rewards above.
         _ => f64::NAN,
     }
@@ -210,6 +219,7 @@ impl LbmEnv3 {
         physics.reward = RewardSpec::DragLift { lift_weight: 0.0 };
         physics.agent_reward = Default::default();
         physics.ramp = Default::default();
+        physics.gust = None;
         let hash = physics.hash();
         self.cache_dir
             .as_ref()
@@ -290,6 +300,16 @@ impl LbmEnv3 {
         Ok(obs)
     }
 
+    /// With a gust, sets the inflow for episode time `t` to `(U, v_gust(t), 0)`; without one,
+    /// the inflow stays as built.
+    fn set_gust(&mut self, t: f64) -> Result<(), LbmError> {
+        let Some(g) = &self.spec.gust else {
+            return Ok(());
+        };
+        let u = self.spec.lattice_velocity;
+        self.solver.set_face_velocity(0, [u, u * g.velocity(t), 0.0])
+    }
+
     fn time(&self) -> f64 {
         (self.solver.time() - self.t0) as f64 * self.units.time_per_step()
     }
@@ -311,6 +331,7 @@ impl LbmEnv3 {
                 *v = self.spec.ramp.blend(self.a_old[k], a_new[k], tau);
             }
             self.actuate(&now);
+            self.set_gust(self.time())?;
             self.solver.step()?;
             for (acc, f) in c.body.iter_mut().zip(self.solver.body_forces()) {
                 (0..3).for_each(|a| acc[a] += f[a] / self.force_scale / n as f64);
@@ -346,6 +367,7 @@ impl Env for LbmEnv3 {
         self.a_old = vec![0.0; self.spec.act_dim()];
         let rest = self.a_old.clone();
         self.actuate(&rest);
+        self.set_gust(0.0).map_err(backend)?;
         let offset = (splitmix64(seed) % 64) * (self.steps_per_action / 2).max(1);
         for _ in 0..offset {
             self.solver.step().map_err(backend)?;

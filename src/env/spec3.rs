@@ -15,7 +15,7 @@ use hgym_agents::multi::AgentReward;
 use hgym_solvers::lbm::Collision;
 
 use super::actuation::Ramp;
-use super::spec::{ActuationSpec, Normalization, RewardSpec, SpongeSpec};
+use super::spec::{ActuationSpec, GustSpec, Normalization, RewardSpec, SpongeSpec};
 use crate::flow::{BoundarySpec, DomainSpec, FlowSetup, GeometrySpec, InletSpec, ResolutionSpec, SpanSpec};
 
 /// The actuators of a 3D environment; actions in `[-1, 1]` are scaled by the bound given here.
@@ -165,7 +165,7 @@ pub struct Env3Spec {
     #[serde(deserialize_with = "crate::flow::pairs")]
     pub probes: Vec<[f64; 2]>,
     /// `drag_lift` or `total_drag_lift`, with the lift the lateral force `(C_L, C_S)`'s magnitude,
-    /// or `probe_deviation`.
+    /// `gust_loads` (lift `C_L`, the y force), or `probe_deviation`.
     pub reward: RewardSpec,
     /// The reward each agent of multi-agent training (one per segment) learns from: the
     /// environment's, or its own segment's `-sum_b |C_D,b,s| - w sum_b |(C_L, C_S)_b,s|`.
@@ -181,6 +181,9 @@ pub struct Env3Spec {
     /// An absorbing layer along one x or y face (the open cavity's top).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sponge: Option<Box<SpongeSpec>>,
+    /// A transverse gust entering through the inlet during each episode (as in 2D).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gust: Option<GustSpec>,
 }
 
 impl Env3Spec {
@@ -266,9 +269,14 @@ impl Env3Spec {
         }
         if !matches!(
             self.reward,
-            RewardSpec::DragLift { .. } | RewardSpec::TotalDragLift { .. } | RewardSpec::ProbeDeviation
+            RewardSpec::DragLift { .. } | RewardSpec::TotalDragLift { .. } | RewardSpec::ProbeDeviation | RewardSpec::GustLoads { .. }
         ) {
-            return Err("reward: 3D flows reward forces or probe deviations: use drag_lift, total_drag_lift or probe_deviation".into());
+            return Err(
+                "reward: 3D flows reward forces or probe deviations: use drag_lift, total_drag_lift, gust_loads or probe_deviation".into(),
+            );
+        }
+        if self.gust.is_some() && self.boundaries.west != crate::flow::BoundaryKind::Inlet {
+            return Err("gust: a gust enters through the inlet; make the west boundary an inlet".into());
         }
         Ok(())
     }
@@ -351,5 +359,6 @@ pub fn extrude(
         spin_up: base.spin_up,
         normalization: Normalization::default(),
         sponge: base.sponge,
+        gust: base.gust,
     }
 }

@@ -98,6 +98,7 @@ pub(super) fn in_box(
         spin_up: 60.0,
         normalization: Normalization::default(),
         sponge: None,
+        gust: None,
     }
 }
 

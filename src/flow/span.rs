@@ -158,6 +158,11 @@ impl LbmFlow3 {
         each!(self, s => s.segment_forces())
     }
 
+    /// Sets the velocity of a velocity face (`2 a` the low end of axis `a`), lattice units.
+    pub fn set_face_velocity(&mut self, face: usize, u: [f64; 3]) -> Result<(), LbmError> {
+        each!(self, s => s.set_face_velocity(face, u))
+    }
+
     pub fn set_boundary_velocity_scale(&mut self, scale: f64) {
         each!(self, s => s.set_velocity_scale(scale))
     }
