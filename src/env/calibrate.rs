@@ -30,6 +30,16 @@ pub struct Entry {
     pub mean_forces: Option<[f64; 2]>,
 }
 
+impl Entry {
+    /// One line for people: the uncontrolled mean forces of `id`.
+    pub fn summary(&self, id: &str) -> String {
+        match self.mean_forces {
+            Some([c_d, c_l]) => format!("{id}: uncontrolled mean C_D {c_d:.4}, mean C_L {c_l:.4}"),
+            None => format!("{id}: calibrated"),
+        }
+    }
+}
+
 /// Hash of the spec with its normalisation removed (what the statistics depend on).
 pub fn physics_hash(spec: &EnvSpec) -> String {
     let mut s = spec.clone();

@@ -267,17 +267,9 @@ impl LbmEnv {
             return Ok(a.clone());
         }
         let want = self.solver.populations().len() + self.thermal.as_ref().map_or(0, |t| t.populations().len());
-        if let Some(path) = self.cache_file() {
-            if let Ok(bytes) = std::fs::read(&path) {
-                if bytes.len() == 4 * want {
-                    let state: Vec<f32> = bytes
-                        .chunks_exact(4)
-                        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-                        .collect();
-                    self.attractor = Some(state.clone());
-                    return Ok(state);
-                }
-            }
+        if let Some(state) = self.cache_file().and_then(|p| super::spin_up::load_state(&p, want)) {
+            self.attractor = Some(state.clone());
+            return Ok(state);
         }
         // Spin up from the uniform flow with a transverse kick just behind the last body (fluid
         // that a body says starts at rest, at rest).
@@ -306,15 +298,7 @@ impl LbmEnv {
             state.extend_from_slice(th.populations());
         }
         if let Some(path) = self.cache_file() {
-            if let Some(dir) = path.parent() {
-                let _ = std::fs::create_dir_all(dir);
-            }
-            let bytes: Vec<u8> = state.iter().flat_map(|v| v.to_le_bytes()).collect();
-            // Write then rename, so a crash never leaves a truncated cache file.
-            let tmp = path.with_extension("tmp");
-            if std::fs::write(&tmp, bytes).is_ok() {
-                let _ = std::fs::rename(&tmp, &path);
-            }
+            super::spin_up::store_state(&path, &state);
         }
         self.attractor = Some(state.clone());
         Ok(state)
@@ -355,12 +339,7 @@ impl LbmEnv {
 
     fn observation(&self) -> Result<Vec<f64>, EnvError> {
         let mut obs = self.raw_observation()?;
-        let n = &self.spec.normalization;
-        if n.mean.len() == obs.len() && n.scale.len() == obs.len() {
-            for ((o, m), s) in obs.iter_mut().zip(&n.mean).zip(&n.scale) {
-                *o = (*o - m) / s;
-            }
-        }
+        self.spec.normalization.apply(&mut obs);
         Ok(obs)
     }
 
@@ -632,10 +611,7 @@ impl FamilySpec for EnvSpec {
     ) -> Result<(String, PathBuf), CalibrateError> {
         let table = super::family::calibration_table::<super::calibrate::Entry>(actions, table, super::calibrate::TABLE_PATH)?;
         let entry = super::calibrate::calibrate(self, level, actions, cache, &mut |k, _| progress(k))?;
-        let summary = match entry.mean_forces {
-            Some([c_d, c_l]) => format!("{}: uncontrolled mean C_D {c_d:.4}, mean C_L {c_l:.4}", self.id),
-            None => format!("{}: calibrated", self.id),
-        };
+        let summary = entry.summary(&self.id);
         crate::report::table::record(&table, &[(super::calibrate::table_key(&self.id, level), entry)])?;
         Ok((summary, table))
     }

@@ -227,23 +227,16 @@ impl LbmEnv3 {
     }
 
     /// The developed flow: from memory, from the disk cache, or by spinning up from the free
-    /// stream with a kick behind the last body, modulated along the span so that 3D modes grow.
+    /// stream with a kick behind the last body, modulated along the span so that 3D modes grow
+    /// (fluid that a body says starts at rest, the cavity's, at rest).
     fn attractor(&mut self) -> Result<Vec<f32>, EnvError> {
         if let Some(a) = &self.attractor {
             return Ok(a.clone());
         }
         let want = self.solver.populations().len();
-        if let Some(path) = self.cache_file() {
-            if let Ok(bytes) = std::fs::read(&path) {
-                if bytes.len() == 4 * want {
-                    let state: Vec<f32> = bytes
-                        .chunks_exact(4)
-                        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-                        .collect();
-                    self.attractor = Some(state.clone());
-                    return Ok(state);
-                }
-            }
+        if let Some(state) = self.cache_file().and_then(|p| super::spin_up::load_state(&p, want)) {
+            self.attractor = Some(state.clone());
+            return Ok(state);
         }
         let u = self.spec.lattice_velocity;
         let centers: Vec<[f64; 2]> = self.spec.bodies.iter().map(|b| b.center()).collect();
@@ -251,7 +244,11 @@ impl LbmEnv3 {
         let y_mid = centers.iter().map(|c| c[1]).sum::<f64>() / centers.len().max(1) as f64;
         let c = [x_back, y_mid];
         let (z0, lz) = (self.spec.span.z[0], self.spec.span.length());
+        let bodies = &self.spec.bodies;
         self.solver.init_with(|p| {
+            if bodies.iter().any(|b| b.starts_at_rest([p[0], p[1]])) {
+                return (1.0, [0.0; 3]);
+            }
             let r2 = (p[0] - c[0] - 1.0).powi(2) + (p[1] - c[1] - 0.25).powi(2);
             let along = 1.0 + 0.5 * (2.0 * std::f64::consts::PI * (p[2] - z0) / lz).sin();
             (1.0, [u, 0.3 * u * along * (-4.0 * r2).exp(), 0.0])
@@ -264,15 +261,7 @@ impl LbmEnv3 {
             .map_err(|e| EnvError::Backend(format!("{}: spin-up diverged: {e}", self.spec.id)))?;
         let state = self.solver.populations().to_vec();
         if let Some(path) = self.cache_file() {
-            if let Some(dir) = path.parent() {
-                let _ = std::fs::create_dir_all(dir);
-            }
-            let bytes: Vec<u8> = state.iter().flat_map(|v| v.to_le_bytes()).collect();
-            // Write then rename, so a crash never leaves a truncated cache file.
-            let tmp = path.with_extension("tmp");
-            if std::fs::write(&tmp, bytes).is_ok() {
-                let _ = std::fs::rename(&tmp, &path);
-            }
+            super::spin_up::store_state(&path, &state);
         }
         self.attractor = Some(state.clone());
         Ok(state)
@@ -291,12 +280,7 @@ impl LbmEnv3 {
 
     fn observation(&self) -> Result<Vec<f64>, EnvError> {
         let mut obs = self.raw_observation()?;
-        let n = &self.spec.normalization;
-        if n.mean.len() == obs.len() && n.scale.len() == obs.len() {
-            for ((o, m), s) in obs.iter_mut().zip(&n.mean).zip(&n.scale) {
-                *o = (*o - m) / s;
-            }
-        }
+        self.spec.normalization.apply(&mut obs);
         Ok(obs)
     }
 
@@ -606,10 +590,7 @@ impl FamilySpec for Env3Spec {
             level: level.name().into(),
             ..entry
         };
-        let summary = match entry.mean_forces {
-            Some([c_d, c_l]) => format!("{}: uncontrolled mean C_D {c_d:.4}, mean C_L {c_l:.4}", self.id),
-            None => format!("{}: calibrated", self.id),
-        };
+        let summary = entry.summary(&self.id);
         crate::report::table::record(&table, &[(super::calibrate::table_key(&self.id, level), entry)])?;
         Ok((summary, table))
     }

@@ -89,6 +89,18 @@ pub struct Normalization {
     pub scale: Vec<f64>,
 }
 
+impl Normalization {
+    /// `obs = (raw - mean) / scale` in place, when calibrated for this many observations (raw
+    /// values otherwise).
+    pub fn apply(&self, obs: &mut [f64]) {
+        if self.mean.len() == obs.len() && self.scale.len() == obs.len() {
+            for ((o, m), s) in obs.iter_mut().zip(&self.mean).zip(&self.scale) {
+                *o = (*o - m) / s;
+            }
+        }
+    }
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct EnvSpec {
@@ -228,13 +240,7 @@ impl EnvSpec {
     pub(crate) fn check(&self) -> Result<(), String> {
         self.flow_setup().check().map_err(|e| e.to_string())?;
         super::family::check_episode(self.control_interval, self.episode_actions, self.spin_up)?;
-        if self.probes.is_empty() {
-            return Err("probes must list at least one [x, y] position (the observation)".into());
-        }
-        if let Some(p) = self.probes.iter().find(|p| p.iter().any(|v| !v.is_finite())) {
-            return Err(format!("probe {p:?} is not a finite position"));
-        }
-        Ok(())
+        check_probes(&self.probes)
     }
 
     /// The flow this environment runs (what `FlowSetup::build` makes its solver from): a
@@ -267,6 +273,17 @@ impl EnvSpec {
     pub fn to_toml(&self) -> String {
         toml::to_string(self).unwrap_or_else(|e| format!("# cannot print the spec as TOML: {e}\n"))
     }
+}
+
+/// At least one probe, every one at a finite position.
+pub(crate) fn check_probes(probes: &[[f64; 2]]) -> Result<(), String> {
+    if probes.is_empty() {
+        return Err("probes must list at least one [x, y] position (the observation)".into());
+    }
+    if let Some(p) = probes.iter().find(|p| p.iter().any(|v| !v.is_finite())) {
+        return Err(format!("probe {p:?} is not a finite position"));
+    }
+    Ok(())
 }
 
 /// Probes on the grid `xs x ys` (x-major), the usual wake rake.

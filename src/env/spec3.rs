@@ -238,12 +238,7 @@ impl Env3Spec {
     pub(crate) fn check(&self) -> Result<(), String> {
         self.flow_setup().check().map_err(|e| e.to_string())?;
         super::family::check_episode(self.control_interval, self.episode_actions, self.spin_up)?;
-        if self.probes.is_empty() {
-            return Err("probes must list at least one [x, y] position (the observation)".into());
-        }
-        if let Some(p) = self.probes.iter().find(|p| p.iter().any(|v| !v.is_finite())) {
-            return Err(format!("probe {p:?} is not a finite position"));
-        }
+        super::spec::check_probes(&self.probes)?;
         match &self.actuation {
             Actuation3Spec::Segments { actuator } => {
                 if matches!(actuator, ActuationSpec::InletTemperature { .. }) {
