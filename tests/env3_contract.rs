@@ -1,6 +1,7 @@
-//! The 3D lattice-Boltzmann environments (`*_3D_*`): Gymnasium's contract over every registered
-//! ID at the coarse level (the real coarse grids; spin-up and control interval shortened so the
-//! suite stays short; `hgym eval --policy random` runs full episodes), per-segment forces that
+//! The 3D lattice-Boltzmann environments (`*_3D_*`): Gymnasium's contract for each family at the
+//! coarse level (the real coarse grids; spin-up and control interval shortened so the suite
+//! stays short; `hgym eval --policy random` runs full episodes, and the Python tests run
+//! Gymnasium's own checker over every ID), per-segment forces that
 //! add up to the body's, one agent per segment for multi-agent training, and bitwise-repeatable
 //! trajectories.
 
@@ -33,9 +34,12 @@ fn specs3() -> Vec<Env3Spec> {
     registry::all().iter().filter_map(|s| s.downcast::<Env3Spec>().cloned()).collect()
 }
 
+/// The first 3D ID of each family (Python's `test_gymnasium.py` runs Gymnasium's checker over
+/// every ID, these included).
 #[test]
-fn every_3d_id_keeps_the_env_contract_at_coarse() {
+fn each_3d_family_keeps_the_env_contract_at_coarse() {
     let specs = specs3();
+    let mut seen = std::collections::BTreeSet::new();
     for family in [
         "cylinder",
         "rotary_cylinder",
@@ -48,7 +52,7 @@ fn every_3d_id_keeps_the_env_contract_at_coarse() {
     ] {
         assert!(specs.iter().any(|s| s.family == family), "no 3D {family} ID registered");
     }
-    for spec in specs {
+    for spec in specs.into_iter().filter(|s| seen.insert(s.family.clone())) {
         let id = spec.id.clone();
         let spec = shortest(&spec, 3);
         let start = std::time::Instant::now();

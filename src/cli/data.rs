@@ -52,7 +52,7 @@ pub fn run_export(args: ExportArgs) -> Result<Outcome> {
         ..ExportOptions::default()
     };
     let paths = hgym::data::hf::find_trajectories(&args.dir)?;
-    let pb = super::progress::Progress::new(paths.len() as u64, "reading");
+    let pb = super::progress::Progress::counting(paths.len() as u64, "reading", "files");
     let report = export(&args.dir, &args.out, &opts, &mut |k, _| pb.set_position(k as u64))?;
     pb.finish_and_clear();
     if args.json {

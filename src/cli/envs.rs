@@ -116,13 +116,18 @@ pub fn run(args: EnvsArgs) -> Result<Outcome> {
         }) => {
             let spec = hgym::env::lookup(&id)?;
             let (pool, _) = thread_pool(threads)?;
-            let pb = Progress::new(actions as u64, &id);
+            // Made at the first action's report, so that its clock leaves out the spin-up (which
+            // reports on its own).
+            let mut pb: Option<Progress> = None;
             let result = pool.install(|| {
                 spec.calibrate(level, actions, hgym::env::default_cache_dir(), table.as_deref(), &mut |k| {
-                    pb.set_position(k as u64)
+                    pb.get_or_insert_with(|| Progress::counting(actions as u64, &id, "actions"))
+                        .set_position(k as u64)
                 })
             });
-            pb.finish_and_clear();
+            if let Some(pb) = &pb {
+                pb.finish_and_clear();
+            }
             let (summary, written) = match result {
                 Err(CalibrateError::Table(e)) => {
                     return Err(UsageError(format!("{e} (run from the repository root, or pass --table)")).into())

@@ -16,12 +16,13 @@ pub fn progress_bar(total: u64, label: &str) -> ProgressBar {
     if !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
-    styled_bar(total, label)
+    styled_bar(total, label, "steps")
 }
 
-fn styled_bar(total: u64, label: &str) -> ProgressBar {
+fn styled_bar(total: u64, label: &str, unit: &str) -> ProgressBar {
     let pb = ProgressBar::new(total);
-    let style = ProgressStyle::with_template("{msg:>16} [{bar:40.cyan/blue}] {pos}/{len} steps, {per_sec}, eta {eta}")
+    let template = format!("{{msg:>16}} [{{bar:40.cyan/blue}}] {{pos}}/{{len}} {unit}, {{per_sec}}, eta {{eta}}");
+    let style = ProgressStyle::with_template(&template)
         .unwrap_or_else(|_| ProgressStyle::default_bar())
         .progress_chars("=> ");
     pb.set_style(style);
@@ -36,16 +37,22 @@ pub struct Progress {
 }
 
 impl Progress {
+    /// Progress over `total` solver steps.
     pub fn new(total: u64, label: &str) -> Self {
+        Self::counting(total, label, "steps")
+    }
+
+    /// Progress over `total` things called `unit` (`actions`, `files`).
+    pub fn counting(total: u64, label: &str, unit: &str) -> Self {
         if std::io::stderr().is_terminal() {
             Progress {
-                bar: styled_bar(total, label),
+                bar: styled_bar(total, label, unit),
                 log: None,
             }
         } else {
             Progress {
                 bar: ProgressBar::hidden(),
-                log: Some(TenthsLog::new(total, label)),
+                log: Some(TenthsLog::new(total, label, unit)),
             }
         }
     }
@@ -90,15 +97,17 @@ pub fn spin_up_progress(serial: u64, id: &str, done: u64, total: u64) {
 /// The plain-text reports: which tenth comes next, and the clock they are timed by.
 struct TenthsLog {
     label: String,
+    unit: String,
     total: u64,
     next_tenth: AtomicU64,
     start: Instant,
 }
 
 impl TenthsLog {
-    fn new(total: u64, label: &str) -> Self {
+    fn new(total: u64, label: &str, unit: &str) -> Self {
         TenthsLog {
             label: label.to_string(),
+            unit: unit.to_string(),
             total,
             next_tenth: AtomicU64::new(1),
             start: Instant::now(),
@@ -118,14 +127,15 @@ impl TenthsLog {
         }
         let elapsed = self.start.elapsed().as_secs_f64();
         if done == self.total {
-            return Some(format!("{}: 100% ({done} steps) in {}", self.label, duration(elapsed)));
+            return Some(format!("{}: 100% ({done} {}) in {}", self.label, self.unit, duration(elapsed)));
         }
         let left = elapsed * (self.total - done) as f64 / done as f64;
         Some(format!(
-            "{}: {}% ({done} of {} steps), {} so far, about {} to go",
+            "{}: {}% ({done} of {} {}), {} so far, about {} to go",
             self.label,
             10 * tenth,
             self.total,
+            self.unit,
             duration(elapsed),
             duration(left)
         ))
@@ -148,7 +158,7 @@ mod tests {
 
     #[test]
     fn one_line_per_tenth_and_none_twice() {
-        let log = TenthsLog::new(1000, "case");
+        let log = TenthsLog::new(1000, "case", "steps");
         assert!(log.line(0).is_none());
         assert!(log.line(99).is_none());
         let first = log.line(100).expect("10 % is reported");
@@ -159,7 +169,7 @@ mod tests {
         assert!(log.line(750).is_none());
         assert!(log.line(1000).expect("100 %").starts_with("case: 100% (1000 steps) in "));
         assert!(log.line(1000).is_none());
-        assert!(TenthsLog::new(0, "empty").line(0).is_none());
+        assert!(TenthsLog::new(0, "empty", "steps").line(0).is_none());
     }
 
     #[test]

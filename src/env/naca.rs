@@ -1,7 +1,8 @@
 //! NACA 0012 family (HydroGym "Flow around a NACA 0012 airfoil"):
 //! `NACA0012_2D_Re{100,1000}_AoA{20,40}` (wake stabilisation in steady inflow) and
 //! `NACA0012Gust_2D_Re{100,1000}_AoA{20,40}` (transverse gust mitigation), and
-//! `NACA0012_3D_Re{100,1000}_AoA{20,40}`, the steady ones over a span of 4 c ([`steady_3d`]).
+//! `NACA0012_3D_Re{100,1000}_AoA{20,40}`, the steady ones over a span of 4 c ([`steady_3d`]), and
+//! `NACA0012Gust_3D_Re1000_AoA20`, the paper's main-text gust case ([`gust_3d`]).
 //!
 //! Set-up: chord c = 1 (the reference length), leading edge at (6.5, 0), rotated nose-up by the
 //! angle of attack about the leading edge, in `[0, 20] x [-6, 6]` (the paper's m-AIA 2D runs use
@@ -220,6 +221,8 @@ pub fn steady_3d(re: u32, aoa: u32) -> super::spec3::Env3Spec {
 /// references' offset.
 pub fn reference_coefficients_3d(re: u32, aoa: u32) -> Option<(f64, f64)> {
     match (re, aoa) {
+        // Calibrated 2026-11-27 (coarse level, 100 actions): C_D 0.3898, C_L 0.5785.
+        (1000, 20) => Some((0.5784674983351564, 0.3897719155324764)),
         _ => None,
     }
 }
