@@ -281,39 +281,6 @@ impl Env3Spec {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn round_jet_is_parabolic_about_its_axis_and_local() {
-        let j = Jet3::on_sphere([0.0; 3], 0.5, [1.0, 0.0, 0.0], 15.0);
-        let peak = j.profile([0.5, 0.0, 0.0]);
-        assert!((peak[0] - 1.0).abs() < 1e-12 && peak[1] == 0.0 && peak[2] == 0.0);
-        let rim = 0.5 * 15f64.to_radians().sin();
-        let edge = j.profile([0.5 * 15f64.to_radians().cos(), rim, 0.0]);
-        assert!(edge[0].abs() < 1e-9, "{edge:?}");
-        assert_eq!(j.profile([-0.5, 0.0, 0.0]), [0.0; 3], "the opposite side of the sphere");
-        let half = j.profile([0.5, 0.5 * rim, 0.0]);
-        assert!((half[0] - 0.75).abs() < 1e-12, "{half:?}");
-    }
-
-    #[test]
-    fn slot_covers_its_length_and_not_beyond() {
-        let j = Jet3 {
-            center: [0.0, 0.5, 0.0],
-            direction: [0.0, 1.0, 0.0],
-            width: 0.2,
-            length: 0.8,
-            slot_axis: [0.0, 0.0, 1.0],
-        };
-        assert_eq!(j.profile([0.0, 0.5, 0.39]), [0.0, 1.0, 0.0]);
-        assert_eq!(j.profile([0.0, 0.5, 0.41]), [0.0; 3]);
-        assert!((j.profile([0.05, 0.5, 0.0])[1] - 0.75).abs() < 1e-12);
-        assert_eq!(j.profile([0.0, -0.5, 0.0]), [0.0; 3]);
-    }
-}
-
 /// The 3D version of a 2D environment: the same bodies (sections extruded along the span),
 /// boundaries, flow numbers, actuator (on every segment separately), probes, reward and timing,
 /// in the x-y box `domain` over `span`, at `resolution`. With more than one segment each agent
@@ -355,5 +322,38 @@ pub fn extrude(
         normalization: Normalization::default(),
         sponge: base.sponge,
         gust: base.gust,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_jet_is_parabolic_about_its_axis_and_local() {
+        let j = Jet3::on_sphere([0.0; 3], 0.5, [1.0, 0.0, 0.0], 15.0);
+        let peak = j.profile([0.5, 0.0, 0.0]);
+        assert!((peak[0] - 1.0).abs() < 1e-12 && peak[1] == 0.0 && peak[2] == 0.0);
+        let rim = 0.5 * 15f64.to_radians().sin();
+        let edge = j.profile([0.5 * 15f64.to_radians().cos(), rim, 0.0]);
+        assert!(edge[0].abs() < 1e-9, "{edge:?}");
+        assert_eq!(j.profile([-0.5, 0.0, 0.0]), [0.0; 3], "the opposite side of the sphere");
+        let half = j.profile([0.5, 0.5 * rim, 0.0]);
+        assert!((half[0] - 0.75).abs() < 1e-12, "{half:?}");
+    }
+
+    #[test]
+    fn slot_covers_its_length_and_not_beyond() {
+        let j = Jet3 {
+            center: [0.0, 0.5, 0.0],
+            direction: [0.0, 1.0, 0.0],
+            width: 0.2,
+            length: 0.8,
+            slot_axis: [0.0, 0.0, 1.0],
+        };
+        assert_eq!(j.profile([0.0, 0.5, 0.39]), [0.0, 1.0, 0.0]);
+        assert_eq!(j.profile([0.0, 0.5, 0.41]), [0.0; 3]);
+        assert!((j.profile([0.05, 0.5, 0.0])[1] - 0.75).abs() < 1e-12);
+        assert_eq!(j.profile([0.0, -0.5, 0.0]), [0.0; 3]);
     }
 }

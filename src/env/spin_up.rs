@@ -49,6 +49,30 @@ pub(crate) fn run_reported<E>(id: &str, total: u64, mut advance: impl FnMut(u64)
     Ok(())
 }
 
+/// A developed-flow state cached at `path` (little-endian f32), if there is one of `len` values.
+pub fn load_state(path: &std::path::Path, len: usize) -> Option<Vec<f32>> {
+    let bytes = std::fs::read(path).ok()?;
+    (bytes.len() == 4 * len).then(|| {
+        bytes
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .collect()
+    })
+}
+
+/// Caches `state` at `path`: written to a temporary file, then renamed, so a crash never leaves
+/// a truncated cache file. A cache that cannot be written is skipped (the next run spins up again).
+pub fn store_state(path: &std::path::Path, state: &[f32]) {
+    if let Some(dir) = path.parent() {
+        let _ = std::fs::create_dir_all(dir);
+    }
+    let bytes: Vec<u8> = state.iter().flat_map(|v| v.to_le_bytes()).collect();
+    let tmp = path.with_extension("tmp");
+    if std::fs::write(&tmp, bytes).is_ok() {
+        let _ = std::fs::rename(&tmp, path);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -90,29 +114,5 @@ mod tests {
         });
         assert_eq!((r, calls), (Err("diverged"), 3));
         assert_eq!(SEEN.lock().unwrap().last(), Some(&(10, 0)), "5 steps a chunk, 2 chunks done");
-    }
-}
-
-/// A developed-flow state cached at `path` (little-endian f32), if there is one of `len` values.
-pub fn load_state(path: &std::path::Path, len: usize) -> Option<Vec<f32>> {
-    let bytes = std::fs::read(path).ok()?;
-    (bytes.len() == 4 * len).then(|| {
-        bytes
-            .chunks_exact(4)
-            .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-            .collect()
-    })
-}
-
-/// Caches `state` at `path`: written to a temporary file, then renamed, so a crash never leaves
-/// a truncated cache file. A cache that cannot be written is skipped (the next run spins up again).
-pub fn store_state(path: &std::path::Path, state: &[f32]) {
-    if let Some(dir) = path.parent() {
-        let _ = std::fs::create_dir_all(dir);
-    }
-    let bytes: Vec<u8> = state.iter().flat_map(|v| v.to_le_bytes()).collect();
-    let tmp = path.with_extension("tmp");
-    if std::fs::write(&tmp, bytes).is_ok() {
-        let _ = std::fs::rename(&tmp, path);
     }
 }

@@ -43,7 +43,7 @@ impl Sponge3Plan {
     /// `sigma` at node `p` of a box of `n` nodes, zero outside the layer.
     pub fn sigma(&self, p: [usize; 3], n: [usize; 3]) -> f32 {
         let a = self.face / 2;
-        let depth = if self.face % 2 == 0 {
+        let depth = if self.face.is_multiple_of(2) {
             self.width as isize - p[a] as isize
         } else {
             p[a] as isize + self.width as isize + 1 - n[a] as isize
@@ -65,7 +65,7 @@ pub(crate) fn apply_plane(plans: &[Sponge3Plan], plane: &mut [f32], z: usize, n:
         let range = |a: usize| {
             if a != p.face / 2 {
                 0..n[a]
-            } else if p.face % 2 == 0 {
+            } else if p.face.is_multiple_of(2) {
                 0..p.width.min(n[a])
             } else {
                 n[a].saturating_sub(p.width)..n[a]
