@@ -23,6 +23,14 @@ SHORT = {"episode_actions": 3}
 # control interval of a few lattice steps, on their registered grids.
 SHORT_3D = {**SHORT, "spin_up": 0.1, "control_interval": 0.005}
 SHORTS = {e["id"]: SHORT_3D if e["dimension"] == 3 and e["solver"].startswith("lbm") else SHORT for e in hgym.envs()}
+# Gymnasium's checker runs over every 2D and spectral ID, and over the first 3D lattice-Boltzmann ID
+# of each family: the binding is one code path per family, and the Rust contract
+# (tests/env3_contract.rs) checks every 3D ID (each 3D check costs 6-27 s here).
+FIRST_3D = {}
+for e in hgym.envs():
+    if SHORTS[e["id"]] is SHORT_3D:
+        FIRST_3D.setdefault(e["family"], e["id"])
+CHECKED = [i for i in IDS if SHORTS[i] is not SHORT_3D or i in FIRST_3D.values()]
 
 
 def hgym_binary() -> str:
@@ -38,7 +46,7 @@ def test_every_id_is_registered_with_its_spec():
         assert e["obs_dim"] > 0 and e["act_dim"] > 0 and e["control_interval"] > 0
 
 
-@pytest.mark.parametrize("env_id", IDS)
+@pytest.mark.parametrize("env_id", CHECKED)
 def test_gymnasium_check_env_passes_at_coarse(env_id):
     env = gym.make(f"hgym/{env_id}-v0", level="coarse", render_mode="rgb_array", **SHORTS[env_id])
     check_env(env.unwrapped, skip_render_check=False)
