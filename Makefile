@@ -16,7 +16,7 @@ PYTHON ?= python3
 # false): the lint that asks for partial_cmp there would make each check longer, not clearer.
 CLIPPY_ALLOW := -A clippy::neg_cmp_op_on_partial_ord
 
-.PHONY: all setup build test validate bench nightly lint fmt clean help leaderboard peers roofline python
+.PHONY: all setup build test validate bench nightly lint fmt clean help leaderboard peers roofline python mpi
 
 help:
 	@echo "make validate   build, then validate the D2Q9 solver on the cylinder at Re 100 (LEVEL=$(LEVEL); the rest: make nightly)"
@@ -25,6 +25,7 @@ help:
 	@echo "make roofline   hgym's copy bandwidth (the bench's roofline) beside STREAM's C copy, alternating"
 	@echo "make nightly    validations (default level), benchmarks, short trainings, leaderboard; results/nightly/summary.md"
 	@echo "make peers      install the peers hgym bench --peer runs beside ours (SB3, hydrogym[jax]; ~7 GB)"
+	@echo "make mpi        install Open MPI (Debian packages), build the MPI solver test and run it on 2 and 3 ranks"
 	@echo "make python     build the Python package (python/, an abi3 wheel) and install it into the test venv"
 	@echo "make lint       rustfmt and clippy"
 	@echo "make leaderboard  aggregate results/ into results/LEADERBOARD.md"
@@ -83,6 +84,26 @@ bench: build
 # alternating pairs (bandwidth drifts by +-20 % from minute to minute).
 $(CARGO_TARGET_DIR)/stream_copy: benchmarks/stream/copy.c
 	$(CC) -O3 -march=native -fopenmp $< -o $@
+
+# The solver split over MPI ranks (the `mpi` feature, rsmpi): Debian's Open MPI and libclang (for
+# rsmpi's bindings) are installed if missing. Two checks, 2 and 3 ranks against one process,
+# bitwise (exit 1 if they differ): the solver alone (examples/mpi_split.rs), and a validation case
+# through the whole command line, `mpirun -np N hgym-mpi validate` (scripts/mpi_check.sh). The
+# default build needs none of this; `hgym-mpi` is built beside `hgym`, not over it.
+MPIRUN := mpirun --allow-run-as-root --oversubscribe --bind-to none
+MPI_SPLIT := $(CARGO_TARGET_DIR)/release/examples/mpi_split
+HGYM_MPI := $(CARGO_TARGET_DIR)/release/hgym-mpi
+
+mpi: build
+	@dpkg -s libopenmpi-dev openmpi-bin libclang-dev >/dev/null 2>&1 || { \
+		SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+		$$SUDO apt-get install -y -q libopenmpi-dev openmpi-bin libclang-dev || \
+		{ $$SUDO apt-get update -q && $$SUDO apt-get install -y -q libopenmpi-dev openmpi-bin libclang-dev; }; }
+	$(CARGO) build --release --locked -p hgym-solvers --features mpi --example mpi_split
+	$(CARGO) build --release --locked --features mpi --bin hgym-mpi
+	$(MPIRUN) -np 2 $(MPI_SPLIT)
+	$(MPIRUN) -np 3 $(MPI_SPLIT)
+	HGYM=$(HGYM) HGYM_MPI=$(HGYM_MPI) MPIRUN="$(MPIRUN)" scripts/mpi_check.sh tests/cases/sphere_mpi.toml
 
 roofline: build $(CARGO_TARGET_DIR)/stream_copy
 	HGYM=$(HGYM) C_COPY=$(CARGO_TARGET_DIR)/stream_copy scripts/roofline.sh

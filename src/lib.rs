@@ -6,7 +6,7 @@
 //! validation against the literature ([`validate`]) and of each environment's own flow
 //! ([`fidelity`]), plots, reports and the leaderboard ([`report`]), speed benchmarks
 //! ([`bench`]). The binary `hgym` is a thin command line over these modules (`src/main.rs`,
-//! `src/cli/`). `env` and `validate` both build on `flow` and never on each other.
+//! `src/cli/`); `hgym-mpi`, the same command line, runs one process per MPI rank ([`flow::ranks`]). `env` and `validate` both build on `flow` and never on each other.
 //!
 //! Units: environments and validation cases speak the paper's non-dimensional units (reference
 //! length D = 1, free-stream velocity U = 1, time in D/U); lattice units stay inside the solvers

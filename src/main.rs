@@ -1,7 +1,7 @@
-//! `hgym`: the command line. Parses, hands each command to its file in `src/cli/` (its arguments
-//! and its `run`), and maps the outcome to an exit code in one place: 0 ok, 1 a check failed
-//! (validation out of tolerance, solver diverged, benchmark short of its target), 2 bad usage or
-//! bad input.
+// `hgym`: the command line. Parses, hands each command to its file in `src/cli/` (its arguments
+// and its `run`), and maps the outcome to an exit code in one place: 0 ok, 1 a check failed
+// (validation out of tolerance, solver diverged, benchmark short of its target), 2 bad usage or
+// bad input.
 
 use std::process::ExitCode;
 
@@ -19,6 +19,7 @@ macro_rules! println {
     ($($arg:tt)*) => { $crate::cli::out::write_out(format_args!("{}\n", format_args!($($arg)*))) };
 }
 
+#[path = "cli/mod.rs"]
 mod cli;
 use hgym::validate::ValidateError;
 
@@ -106,6 +107,25 @@ enum Outcome {
 }
 
 fn main() -> ExitCode {
+    // `hgym-mpi`: start MPI and learn this process's rank before anything prints (see `hgym::flow::ranks`).
+    #[cfg(feature = "mpi")]
+    let _universe = {
+        use mpi::traits::Communicator;
+        // The solver is stepped from a worker thread, one call at a time.
+        let Some((universe, provided)) = mpi::initialize_with_threading(mpi::Threading::Serialized) else {
+            eprintln!("error: MPI was already initialised");
+            return ExitCode::from(1);
+        };
+        if matches!(provided, mpi::Threading::Single | mpi::Threading::Funneled) {
+            eprintln!(
+                "error: this MPI library allows calls from the main thread only ({provided:?}); hgym-mpi needs MPI_THREAD_SERIALIZED"
+            );
+            return ExitCode::from(1);
+        }
+        let world = universe.world();
+        hgym::flow::ranks::set(world.rank() as usize, world.size() as usize);
+        universe
+    };
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
@@ -114,6 +134,12 @@ fn main() -> ExitCode {
             return ExitCode::from(code);
         }
     };
+    if let Some(refused) = refused_under_mpi(&cli.command) {
+        if hgym::flow::ranks::leader() {
+            eprintln!("error: {refused}");
+        }
+        return ExitCode::from(2);
+    }
     hgym::env::spin_up::observe_spin_ups(cli::progress::spin_up_progress);
     let result = match cli.command {
         Command::Validate(args) => cli::validate::run(args),
@@ -134,7 +160,10 @@ fn main() -> ExitCode {
         Ok(Outcome::Ok) => ExitCode::SUCCESS,
         Ok(Outcome::CheckFailed) => ExitCode::from(1),
         Err(e) => {
-            eprintln!("error: {e:#}");
+            match hgym::flow::ranks::rank() {
+                (0, _) => eprintln!("error: {e:#}"),
+                (r, _) => eprintln!("error (rank {r}): {e:#}"),
+            }
             ExitCode::from(if is_bad_input(&e) { 2 } else { 1 })
         }
     }
@@ -169,6 +198,14 @@ fn is_bad_input(e: &anyhow::Error) -> bool {
                 Some(hgym::env::family::CalibrateError::NoActions)
             )
     })
+}
+
+/// Why a command cannot run on several MPI ranks yet, if it cannot: only validation keeps its
+/// files to rank 0 so far; the others would write them from every rank.
+fn refused_under_mpi(command: &Command) -> Option<String> {
+    let size = hgym::flow::ranks::rank().1;
+    (size > 1 && !matches!(command, Command::Validate(_)))
+        .then(|| format!("on {size} MPI ranks hgym-mpi runs `validate` only so far; run this command with `hgym` (one process)"))
 }
 
 /// A command-line mistake the CLI itself finds (exit code 2).

@@ -17,6 +17,7 @@
 //! Errors are typed ([`lbm::LbmError`]); nothing here panics on user input.
 
 pub mod channel;
+pub mod comm;
 pub mod geometry;
 pub mod lbm;
 pub mod spectral;

@@ -5,8 +5,11 @@
 use std::io::Write;
 
 /// Writes `args` to standard output; on a closed pipe exits with 0, on another write error
-/// with 1 after saying so on standard error.
+/// with 1 after saying so on standard error. Under MPI only rank 0 prints.
 pub fn write_out(args: std::fmt::Arguments) {
+    if !hgym::flow::ranks::leader() {
+        return;
+    }
     let mut out = std::io::stdout().lock();
     if let Err(e) = out.write_fmt(args) {
         if e.kind() == std::io::ErrorKind::BrokenPipe {

@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 
 /// An indicatif bar on a terminal (hidden otherwise), labelled `label`, over `total` steps.
 pub fn progress_bar(total: u64, label: &str) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
+    if !std::io::stderr().is_terminal() || !hgym::flow::ranks::leader() {
         return ProgressBar::hidden();
     }
     styled_bar(total, label, "steps")
@@ -44,6 +44,13 @@ impl Progress {
 
     /// Progress over `total` things called `unit` (`actions`, `files`).
     pub fn counting(total: u64, label: &str, unit: &str) -> Self {
+        if !hgym::flow::ranks::leader() {
+            // Under MPI rank 0 reports for every rank.
+            return Progress {
+                bar: ProgressBar::hidden(),
+                log: None,
+            };
+        }
         if std::io::stderr().is_terminal() {
             Progress {
                 bar: styled_bar(total, label, unit),

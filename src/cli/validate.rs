@@ -146,9 +146,13 @@ fn run_cases(cases: &[LoadedCase], args: &ValidateArgs, out: &std::path::Path) -
     let mut reports = Vec::new();
     for c in cases {
         let plan = validate::plan(c, args.level)?;
-        if !args.json {
+        if !args.json && hgym::flow::ranks::leader() {
+            let ranks = match hgym::flow::ranks::rank().1 {
+                1 => String::new(),
+                n => format!(", split over {n} MPI ranks"),
+            };
             eprintln!(
-                "{} ({}): {}, {} steps",
+                "{} ({}): {}, {} steps{ranks}",
                 c.case.case.name,
                 args.level.name(),
                 plan.flow.describe(),

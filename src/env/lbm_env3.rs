@@ -221,9 +221,11 @@ impl LbmEnv3 {
         physics.ramp = Default::default();
         physics.gust = None;
         let hash = physics.hash();
-        self.cache_dir
-            .as_ref()
-            .map(|d| d.join(format!("flow3-{}-{}.f32", self.level.name(), &hash[..16])))
+        self.cache_dir.as_ref().map(|d| match self.solver.rank() {
+            (_, 1) => d.join(format!("flow3-{}-{}.f32", self.level.name(), &hash[..16])),
+            // Under MPI each rank keeps its own slab.
+            (r, n) => d.join(format!("flow3-{}-{}-rank{r}of{n}.f32", self.level.name(), &hash[..16])),
+        })
     }
 
     /// The developed flow: from memory, from the disk cache, or by spinning up from the free
@@ -234,9 +236,13 @@ impl LbmEnv3 {
             return Ok(a.clone());
         }
         let want = self.solver.populations().len();
-        if let Some(state) = self.cache_file().and_then(|p| super::spin_up::load_state(&p, want)) {
-            self.attractor = Some(state.clone());
-            return Ok(state);
+        let cached = self.cache_file().and_then(|p| super::spin_up::load_state(&p, want));
+        // Under MPI the ranks spin up together unless every one of them has its slab cached.
+        if self.solver.all_ranks(cached.is_some()) {
+            if let Some(state) = cached {
+                self.attractor = Some(state.clone());
+                return Ok(state);
+            }
         }
         let u = self.spec.lattice_velocity;
         let centers: Vec<[f64; 2]> = self.spec.bodies.iter().map(|b| b.center()).collect();
@@ -466,13 +472,10 @@ impl super::fields::FlowFields for LbmEnv3 {
         let d = &self.spec.domain;
         let extent = [d.x[0], d.x[1], d.y[0], d.y[1]];
         let (mut u, mut v) = (vec![f32::NAN; nx * ny], vec![f32::NAN; nx * ny]);
-        for y in 0..ny {
-            for x in 0..nx {
-                if !self.solver.is_solid([x, y, nz / 2]) {
-                    let (_, w) = self.solver.rho_u([x, y, nz / 2]);
-                    u[y * nx + x] = self.units.velocity(w[0]) as f32;
-                    v[y * nx + x] = self.units.velocity(w[1]) as f32;
-                }
+        for (k, w) in self.solver.velocity_plane(nz / 2).iter().enumerate() {
+            if let Some(w) = w {
+                u[k] = self.units.velocity(w[0]) as f32;
+                v[k] = self.units.velocity(w[1]) as f32;
             }
         }
         let w = crate::flow::field::mid_span_vorticity(&self.solver, &self.units, extent).values;

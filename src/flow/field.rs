@@ -38,12 +38,13 @@ pub fn vorticity_field(s: &D2q9, units: &Units, extent: [f64; 4]) -> Field {
 /// differences, units of U/L; NaN in bodies).
 pub fn mid_span_vorticity(s: &super::LbmFlow3, units: &Units, extent: [f64; 4]) -> Field {
     let [nx, ny, nz] = s.n();
-    let z = nz / 2;
+    let plane = s.velocity_plane(nz / 2);
     let mut w = vec![f32::NAN; nx * ny];
-    let u = |x: usize, y: usize| s.rho_u([x, y, z]).1;
+    // Solid nodes count as resting fluid in the differences.
+    let u = |x: usize, y: usize| plane[y * nx + x].unwrap_or([0.0; 3]);
     for y in 1..ny.saturating_sub(1) {
         for x in 1..nx.saturating_sub(1) {
-            if s.is_solid([x, y, z]) {
+            if plane[y * nx + x].is_none() {
                 continue;
             }
             let dvdx = 0.5 * (u(x + 1, y)[1] - u(x - 1, y)[1]);

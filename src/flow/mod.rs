@@ -19,6 +19,7 @@ pub mod geometry;
 pub mod inlet;
 pub mod level;
 pub mod plan;
+pub mod ranks;
 pub mod span;
 
 use serde::{Deserialize, Deserializer, Serialize};

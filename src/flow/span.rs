@@ -198,13 +198,30 @@ impl LbmFlow3 {
         each!(self, s => s.config().grid)
     }
 
+    /// Whether node `p` is inside a body (a node this rank holds, under MPI).
     pub fn is_solid(&self, p: [usize; 3]) -> bool {
         each!(self, s => s.is_solid(p))
     }
 
-    /// Density and lattice velocity of node `p`.
+    /// Density and lattice velocity of node `p` (a node this rank holds, under MPI).
     pub fn rho_u(&self, p: [usize; 3]) -> (f64, [f64; 3]) {
         each!(self, s => s.rho_u(p))
+    }
+
+    /// Lattice velocity of every node of plane `z`, `[y nx + x]`, `None` inside bodies (every
+    /// rank gets the whole plane).
+    pub fn velocity_plane(&self, z: usize) -> Vec<Option<[f64; 3]>> {
+        each!(self, s => s.velocity_plane(z))
+    }
+
+    /// This process's rank and the number of ranks the box is split over.
+    pub fn rank(&self) -> (usize, usize) {
+        each!(self, s => s.rank())
+    }
+
+    /// Whether `yes` holds on every rank (every rank must ask together).
+    pub fn all_ranks(&self, yes: bool) -> bool {
+        each!(self, s => s.all_ranks(yes))
     }
 
     /// Mass body `b`'s moving walls inject per step (lattice units; see `Lbm3::wall_mass_source`).
@@ -288,8 +305,8 @@ impl FlowSetup {
         let solids: Vec<Box<dyn Solid>> = self.bodies.iter().map(GeometrySpec::solid).collect();
         let bodies: Vec<&dyn Solid> = solids.iter().map(|b| b.as_ref()).collect();
         let built = match span.lattice {
-            Lattice3Name::D3q19 => Lbm3::<19, D3q19>::new(cfg, &bodies).map(|s| LbmFlow3::D3q19(Box::new(s))),
-            Lattice3Name::D3q27 => Lbm3::<27, D3q27>::new(cfg, &bodies).map(|s| LbmFlow3::D3q27(Box::new(s))),
+            Lattice3Name::D3q19 => Lbm3::<19, D3q19>::new_split(cfg, &bodies, super::ranks::comm()).map(|s| LbmFlow3::D3q19(Box::new(s))),
+            Lattice3Name::D3q27 => Lbm3::<27, D3q27>::new_split(cfg, &bodies, super::ranks::comm()).map(|s| LbmFlow3::D3q27(Box::new(s))),
         };
         built.map_err(|e| match e {
             LbmError::Config { field, message } => FlowError::Invalid { field, message },

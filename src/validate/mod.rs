@@ -98,6 +98,9 @@ fn out_err(path: &Path) -> impl Fn(String) -> ValidateError + '_ {
 }
 
 fn write_outputs(report: &ValidationReport, output: &run::RunOutput, out: &Path) -> Result<(), ValidateError> {
+    if !crate::flow::ranks::leader() {
+        return Ok(()); // under MPI rank 0 writes for every rank
+    }
     let dir = out.join(&report.case);
     std::fs::create_dir_all(&dir).map_err(|e| out_err(&dir)(e.to_string()))?;
     report::write_plots(report, output, &dir).map_err(|e| out_err(&dir)(crate::report::chain(&e)))?;

@@ -251,6 +251,7 @@ pub(crate) fn plane<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: 
         let specials = &c.specials[c.row_start[r] as usize..c.row_start[r + 1] as usize];
         for sp in specials {
             let x = sp.x as usize;
+            // A solid node, or a ghost node of a split box (the exchange fills it): zeros.
             if sp.solid {
                 for i in 0..Q {
                     out[(i * ny + y) * nx + x] = 0.0;

@@ -7,6 +7,10 @@
 //! y) nx + x]`), one fused pull-scheme stream-collide pass per step over two arrays, rayon over
 //! z planes, no allocation in a step, and a slow oracle ([`Lbm3::step_reference`]) the fast
 //! kernel is tested against bitwise. After a step, `f` holds the post-collision populations.
+//!
+//! Split over ranks ([`Lbm3::new_split`], a [`Comm`](crate::comm::Comm)), each rank steps a slab
+//! along y or z (not x, the kernel's row) with ghost layers exchanged after every step; forces,
+//! probes and the blow-up scan come out bitwise the same as one process's.
 
 // Loops over directions `i` and axes `a` index several arrays at once, as the sums in the
 // equations do.
@@ -15,11 +19,13 @@
 mod collision;
 mod kernel;
 pub mod lattice;
+mod part;
 mod sides;
 mod solver;
 mod sponge;
 
 pub use lattice::{D3q19, D3q27, Lattice3};
+pub use part::split_axis;
 pub use sides::{Face, Faces};
 pub use solver::{D3Config, Grid3, Lbm3};
 pub use sponge::Sponge3;

@@ -10,8 +10,10 @@ use super::super::solver::STREAM_STORES_ABOVE_BYTES;
 use super::collision::{collide, equilibrium, moments};
 use super::kernel::{bouzidi, gather, index, plane, Ctx, Link, Special, PAD};
 use super::lattice::Lattice3;
+use super::part::Part;
 use super::sides::{Face, Faces};
 use super::sponge::{apply_plane, Sponge3, Sponge3Plan};
+use crate::comm::{Comm, Solo};
 use crate::geometry::Solid;
 
 /// Where node `(i, j, k)` sits in physical space: `origin + (i, j, k) dx`.
@@ -105,15 +107,74 @@ fn plane_fn<const Q: usize, L: Lattice3<Q>>(collision: Collision, forced: bool, 
     monomorphised!(plane, collision, forced, les)
 }
 
-/// A D3Q19 or D3Q27 lattice-Boltzmann solver on a periodic box with immersed bodies.
+/// What the blow-up scan found at a node.
+#[derive(Clone, Copy)]
+enum Bad {
+    NaN,
+    RhoLow(f32),
+    RhoHigh(f32),
+    Speed(f32),
+}
+
+impl Bad {
+    /// As two numbers, to be summed over the ranks.
+    fn code(self) -> (f64, f64) {
+        match self {
+            Bad::NaN => (0.0, 0.0),
+            Bad::RhoLow(v) => (1.0, v as f64),
+            Bad::RhoHigh(v) => (2.0, v as f64),
+            Bad::Speed(v) => (3.0, v as f64),
+        }
+    }
+
+    fn from_code(code: f64, value: f32) -> Self {
+        match code as u8 {
+            1 => Bad::RhoLow(value),
+            2 => Bad::RhoHigh(value),
+            3 => Bad::Speed(value),
+            _ => Bad::NaN,
+        }
+    }
+}
+
+/// Layer `i` along `axis` of a box of `n` nodes as runs of contiguous populations,
+/// `run(start, len)` in a fixed order (the order a layer is packed in for its neighbour).
+fn layer_runs<const Q: usize>(n: [usize; 3], axis: usize, i: usize, mut run: impl FnMut(usize, usize)) {
+    let range = |a: usize| if a == axis { i..i + 1 } else { 0..n[a] };
+    for z in range(2) {
+        for q in 0..Q {
+            for y in range(1) {
+                if axis == 0 {
+                    run(index::<Q>(n, [i, y, z], q), 1);
+                } else {
+                    run(index::<Q>(n, [0, y, z], q), n[0]);
+                }
+            }
+        }
+    }
+}
+
+/// A D3Q19 or D3Q27 lattice-Boltzmann solver on a periodic box with immersed bodies, in one
+/// process or split over ranks ([`Lbm3::new_split`]).
 pub struct Lbm3<const Q: usize, L: Lattice3<Q>> {
+    /// The configuration of the box this process holds (its slab and ghost layers when split).
     cfg: D3Config,
+    /// The configuration of the whole box.
+    global_cfg: D3Config,
+    part: Part,
+    comm: Box<dyn Comm>,
+    /// One layer of populations across the split axis, sent and received after each step.
+    halo_send: Vec<f32>,
+    halo_recv: Vec<f32>,
+    /// Per (body, segment, index along the split axis) force sums, before and after the ranks'
+    /// sum: `[((b segments + s) n_axis + i) 3 + a]`.
+    partial: Vec<f64>,
+    summed: Vec<f64>,
     relax: Relax,
     velocity_scale: f32,
     f: AlignedVec,
     f_next: AlignedVec,
     plan: Plan,
-    bodies: usize,
     /// Force on each (body, segment), `[b * segments + s]`, during the last step.
     segment_forces: Vec<[f64; 3]>,
     body_forces: Vec<[f64; 3]>,
@@ -155,6 +216,15 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     /// whose neighbour is solid (with the wall fraction along the link) and the specials of
     /// every row. The flow starts at rest.
     pub fn new(cfg: D3Config, bodies: &[&dyn Solid]) -> Result<Self, LbmError> {
+        Self::new_split(cfg, bodies, Box::new(Solo))
+    }
+
+    /// This rank's slab of the box `cfg` split over the ranks of `comm` along y or z
+    /// ([`split_axis`](super::split_axis)): every rank calls this, and then every method below
+    /// together (each step exchanges ghost layers; forces, probes, mass and the blow-up scan are
+    /// summed over the ranks, bitwise the same as one process's). Node coordinates in arguments
+    /// and errors are global.
+    pub fn new_split(cfg: D3Config, bodies: &[&dyn Solid], comm: Box<dyn Comm>) -> Result<Self, LbmError> {
         let [nx, ny, nz] = cfg.n;
         let config = |field: &'static str, message: String| LbmError::Config { field, message };
         if nx < 1 || ny < 1 || nz < 1 {
@@ -168,10 +238,6 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                     format!("a layer needs a face 0-5, a width of 1 to the nodes along its axis and a strength in (0, 1]; got {sp:?}"),
                 ));
             }
-        }
-        let cells = nx * ny * nz;
-        if cells >= u32::MAX as usize {
-            return Err(config("n", format!("{cells} nodes exceed the 2^32 a link index can address")));
         }
         if cfg.tau <= 0.5 + cfg.collision.min_tau_margin() {
             return Err(config(
@@ -214,9 +280,29 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         if bodies.len() > u16::MAX as usize {
             return Err(config("bodies", format!("{} bodies; at most {}", bodies.len(), u16::MAX)));
         }
+        // This rank's box: its slab, and a ghost layer (whose faces are placeholders, overwritten
+        // by the exchange) towards each neighbour.
+        let part =
+            Part::of(cfg.n, [0, 1, 2].map(|a| cfg.faces.periodic_axis(a)), comm.rank(), comm.size()).map_err(|m| config("ranks", m))?;
+        let global_cfg = cfg.clone();
+        let mut cfg = cfg;
+        cfg.n = part.local_n();
+        for (ghost, face) in [(part.below, 2 * part.axis), (part.above, 2 * part.axis + 1)] {
+            if ghost.is_some() {
+                cfg.faces.0[face] = Face::Wall;
+            }
+        }
+        let [nx, ny, nz] = cfg.n;
+        let cells = nx * ny * nz;
+        if cells >= u32::MAX as usize {
+            return Err(config(
+                "n",
+                format!("{cells} nodes exceed the 2^32 a link index can address; split the box over more ranks"),
+            ));
+        }
         let periodic = [0, 1, 2].map(|a| cfg.faces.periodic_axis(a));
         let node = |p: [usize; 3]| (p[2] * ny + p[1]) * nx + p[0];
-        let pos = |p: [usize; 3]| cfg.grid.position(p);
+        let pos = |p: [usize; 3]| cfg.grid.position(part.global(p));
         let inside = |x: [f64; 3]| bodies.iter().position(|b| b.sdf(x) < 0.0);
         let mut solid = vec![false; cells];
         // Bodies that are the same at every z: the first plane, copied along the span.
@@ -260,8 +346,10 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                 for x in 0..nx {
                     let p = [x, y, z];
                     let is_solid = solid[node(p)];
+                    // A ghost node is not stepped (the exchange fills it) and has no links.
+                    let skip = is_solid || !part.owns(p);
                     let start = links.len() as u32;
-                    if !is_solid {
+                    if !skip {
                         for k in 1..Q {
                             let Some(s) = source(p, L::C_REF[k]) else { continue };
                             if !solid[node(s)] {
@@ -283,10 +371,10 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                     let end = links.len() as u32;
                     // A row's ends wrap along a periodic x inside the bulk loop (which needs 3 nodes).
                     let end_node = (x == 0 || x + 1 >= nx) && !(periodic[0] && nx >= 3);
-                    if !bulk || is_solid || end > start || end_node {
+                    if !bulk || skip || end > start || end_node {
                         specials.push(Special {
                             x: x as u32,
-                            solid: is_solid,
+                            solid: skip,
                             link_start: start,
                             link_end: end,
                         });
@@ -295,7 +383,16 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             }
         }
         row_start.push(specials.len() as u32);
+        let layer = if part.is_split() { Q * cells / cfg.n[part.axis] } else { 0 };
+        let sums = bodies.len() * cfg.segments * part.n_global[part.axis] * 3;
         Ok(Lbm3 {
+            halo_send: vec![0.0; layer],
+            halo_recv: vec![0.0; layer],
+            partial: vec![0.0; sums],
+            summed: vec![0.0; sums],
+            part,
+            comm,
+            global_cfg,
             sponges: cfg.sponges.iter().map(Sponge3Plan::new::<Q, L>).collect(),
             relax: Relax::new(cfg.tau, cfg.smagorinsky),
             velocity_scale: 1.0,
@@ -308,7 +405,6 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                 row_bulk,
                 links,
             },
-            bodies: bodies.len(),
             segment_forces: vec![[0.0; 3]; bodies.len() * cfg.segments],
             body_forces: vec![[0.0; 3]; bodies.len()],
             time: 0,
@@ -317,8 +413,9 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         })
     }
 
+    /// The configuration of the whole box.
     pub fn config(&self) -> &D3Config {
-        &self.cfg
+        &self.global_cfg
     }
 
     /// Steps taken.
@@ -326,20 +423,45 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         self.time
     }
 
-    fn node(&self, p: [usize; 3]) -> usize {
-        (p[2] * self.cfg.n[1] + p[1]) * self.cfg.n[0] + p[0]
+    /// This rank's number and the number of ranks the box is split over.
+    pub fn rank(&self) -> (usize, usize) {
+        (self.comm.rank(), self.comm.size())
     }
 
+    /// Whether `yes` holds on every rank (every rank calls this together): for decisions the
+    /// ranks must take alike, such as reading a cached state only if every rank has its slab.
+    pub fn all_ranks(&self, yes: bool) -> bool {
+        let mut count = [0.0];
+        self.comm.sum(&[f64::from(u8::from(yes))], &mut count);
+        count[0] == self.comm.size() as f64
+    }
+
+    /// Whether this rank owns global node `p` (its slab, not a ghost layer).
+    pub fn owns(&self, p: [usize; 3]) -> bool {
+        self.part.local(p).is_some_and(|l| self.part.owns(l))
+    }
+
+    /// Index of global node `p`, which this rank must hold (own or as a ghost).
+    fn node(&self, p: [usize; 3]) -> usize {
+        let [nx, ny, _] = self.cfg.n;
+        let l = self
+            .part
+            .local(p)
+            .unwrap_or_else(|| panic!("node {p:?} lies outside this rank's slab {:?}", self.part));
+        (l[2] * ny + l[1]) * nx + l[0]
+    }
+
+    /// Whether global node `p` is inside a body (this rank must hold it).
     pub fn is_solid(&self, p: [usize; 3]) -> bool {
         self.plan.solid[self.node(p)]
     }
 
-    /// Number of links into bodies.
+    /// Number of links into bodies (from the nodes this rank owns).
     pub fn link_count(&self) -> usize {
         self.plan.links.len()
     }
 
-    /// Sets every fluid node to the equilibrium of `init(x, y, z) = (rho, u)`.
+    /// Sets every fluid node to the equilibrium of `init(x, y, z) = (rho, u)` (global node).
     pub fn set_equilibrium(&mut self, init: impl Fn(usize, usize, usize) -> (f64, [f64; 3])) {
         let [nx, ny, nz] = self.cfg.n;
         for z in 0..nz {
@@ -348,7 +470,8 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                     let (rho, u) = if self.plan.solid[(z * ny + y) * nx + x] {
                         (1.0, [0.0; 3])
                     } else {
-                        init(x, y, z)
+                        let [gx, gy, gz] = self.part.global([x, y, z]);
+                        init(gx, gy, gz)
                     };
                     let geq = equilibrium::<Q, L>((rho - 1.0) as f32, u.map(|v| v as f32));
                     for (i, g) in geq.iter().enumerate() {
@@ -359,32 +482,69 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         }
     }
 
-    /// Populations of node `p` (shifted, `f_i - w_i`).
-    fn populations(&self, p: [usize; 3]) -> [f32; Q] {
-        std::array::from_fn(|i| self.f[index::<Q>(self.cfg.n, p, i)])
+    /// Populations of local node `l` (shifted, `f_i - w_i`).
+    fn populations(&self, l: [usize; 3]) -> [f32; Q] {
+        std::array::from_fn(|i| self.f[index::<Q>(self.cfg.n, l, i)])
     }
 
-    /// Density and velocity of node `p` (`u = (j + F/2) / rho` with a body force).
-    pub fn rho_u(&self, p: [usize; 3]) -> (f64, [f64; 3]) {
-        let (drho, j) = moments::<Q, L>(&self.populations(p));
+    fn local_rho_u(&self, l: [usize; 3]) -> (f64, [f64; 3]) {
+        let (drho, j) = moments::<Q, L>(&self.populations(l));
         let rho = 1.0 + drho as f64;
         (rho, [0, 1, 2].map(|a| (j[a] as f64 + 0.5 * self.cfg.body_force[a]) / rho))
     }
 
-    /// Total mass of the fluid, `sum_x sum_i f_i` (f64 sum in node order).
+    /// Density and velocity of global node `p`, which this rank must hold (`u = (j + F/2) / rho`
+    /// with a body force).
+    pub fn rho_u(&self, p: [usize; 3]) -> (f64, [f64; 3]) {
+        let [nx, ny, _] = self.cfg.n;
+        let n = self.node(p);
+        self.local_rho_u([n % nx, (n / nx) % ny, n / (nx * ny)])
+    }
+
+    /// The velocity of every node of the plane at global `z`, `[y nx + x]`, `None` inside bodies;
+    /// on every rank (each node filled in by the rank that owns it).
+    pub fn velocity_plane(&self, z: usize) -> Vec<Option<[f64; 3]>> {
+        let [nx, ny, _] = self.part.n_global;
+        // Per node: 1 (fluid) or 2 (solid) where owned, then the velocity.
+        let mut mine = vec![0.0f64; 4 * nx * ny];
+        for y in 0..ny {
+            for x in 0..nx {
+                if !self.owns([x, y, z]) {
+                    continue;
+                }
+                let v = &mut mine[4 * (y * nx + x)..4 * (y * nx + x + 1)];
+                if self.is_solid([x, y, z]) {
+                    v[0] = 2.0;
+                } else {
+                    let u = self.rho_u([x, y, z]).1;
+                    v.copy_from_slice(&[1.0, u[0], u[1], u[2]]);
+                }
+            }
+        }
+        let mut all = vec![0.0f64; mine.len()];
+        self.comm.sum(&mine, &mut all);
+        all.chunks(4).map(|v| (v[0] == 1.0).then_some([v[1], v[2], v[3]])).collect()
+    }
+
+    /// Total mass of the fluid, `sum_x sum_i f_i`: summed per index along the split axis in node
+    /// order, then over the indices in order (every rank gets the same bits).
     pub fn mass(&self) -> f64 {
-        let mut m = 0.0f64;
+        let a = self.part.axis;
+        let mut per_index = vec![0.0f64; self.part.n_global[a]];
         let [nx, ny, nz] = self.cfg.n;
         for z in 0..nz {
             for y in 0..ny {
                 for x in 0..nx {
-                    if !self.plan.solid[(z * ny + y) * nx + x] {
-                        m += 1.0 + self.populations([x, y, z]).iter().map(|&g| g as f64).sum::<f64>();
+                    let l = [x, y, z];
+                    if self.part.owns(l) && !self.plan.solid[(z * ny + y) * nx + x] {
+                        per_index[self.part.global_index(l[a])] += 1.0 + self.populations(l).iter().map(|&g| g as f64).sum::<f64>();
                     }
                 }
             }
         }
-        m
+        let mut summed = vec![0.0; per_index.len()];
+        self.comm.sum(&per_index, &mut summed);
+        summed.iter().sum()
     }
 
     /// Force of the fluid on each body during the last step (momentum exchange over its links,
@@ -399,27 +559,46 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         &self.segment_forces
     }
 
-    /// Momentum exchange (Ladd 1994; Mei et al. 2002): over every link, the momentum the
-    /// population carries into the wall and back, `c_i (g*_i(x) + g_k(x, t+1))` with
-    /// `i = opp(k)`, summed per (body, segment) in link order, then per body in segment order.
-    /// The rest-state parts `w_i c_i` cancel over a closed body, so the shifted populations give
-    /// the force directly.
-    fn link_forces(c: &Ctx, src: &[f32], segments: usize, per_segment: &mut [[f64; 3]], per_body: &mut [[f64; 3]]) {
-        per_segment.iter_mut().for_each(|f| *f = [0.0; 3]);
-        let [nx, ny, nz] = c.n;
+    /// Momentum exchange (Ladd 1994; Mei et al. 2002): over every link (of owned nodes only), the
+    /// momentum the population carries into the wall and back, `c_i (g*_i(x) + g_k(x, t+1))` with
+    /// `i = opp(k)`, summed in link order per (body, segment, index along the split axis) into
+    /// `partial`. The rest-state parts `w_i c_i` cancel over a closed body, so the shifted
+    /// populations give the force directly.
+    fn link_forces(c: &Ctx, src: &[f32], part: &Part, segments: usize, partial: &mut [f64]) {
+        partial.iter_mut().for_each(|f| *f = 0.0);
+        let [nx, ny, _] = c.n;
+        let n_axis = part.n_global[part.axis];
         for l in c.links {
             let n = l.node as usize;
             let p = [n % nx, (n / nx) % ny, n / (nx * ny)];
+            let g = part.global(p);
             let i = L::OPP_REF[l.k as usize];
-            let g = src[c.idx::<Q>(p, i)] as f64 + bouzidi::<Q, L>(c, src, p, l) as f64;
-            let f = &mut per_segment[l.body as usize * segments + p[2] * segments / nz];
+            let v = src[c.idx::<Q>(p, i)] as f64 + bouzidi::<Q, L>(c, src, p, l) as f64;
+            let s = g[2] * segments / part.n_global[2];
+            let at = ((l.body as usize * segments + s) * n_axis + g[part.axis]) * 3;
             for a in 0..3 {
-                f[a] += L::C_REF[i][a] as f64 * g;
+                partial[at + a] += L::C_REF[i][a] as f64 * v;
             }
         }
-        for (b, total) in per_body.iter_mut().enumerate() {
+    }
+
+    /// The forces per segment (the ranks' partial sums added in order along the split axis) and
+    /// per body (its segments in order).
+    fn total_forces(&mut self) {
+        self.comm.sum(&self.partial, &mut self.summed);
+        let n_axis = self.part.n_global[self.part.axis];
+        for (f, sums) in self.segment_forces.iter_mut().zip(self.summed.chunks(3 * n_axis)) {
+            *f = [0.0; 3];
+            for v in sums.chunks(3) {
+                for a in 0..3 {
+                    f[a] += v[a];
+                }
+            }
+        }
+        let segments = self.cfg.segments;
+        for (b, total) in self.body_forces.iter_mut().enumerate() {
             *total = [0.0; 3];
-            for f in &per_segment[b * segments..(b + 1) * segments] {
+            for f in &self.segment_forces[b * segments..(b + 1) * segments] {
                 for a in 0..3 {
                     total[a] += f[a];
                 }
@@ -427,17 +606,47 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         }
     }
 
-    /// Advances one time step. Allocates nothing.
+    /// Sends the owned layers next to each neighbour into its ghost layer and fills this rank's
+    /// ghosts from them: up the split axis, then down. Allocates nothing.
+    fn exchange(&mut self) {
+        let (axis, n, own) = (self.part.axis, self.cfg.n, self.part.own.clone());
+        // Up: the last owned layer to the rank above, into ghost 0 from the rank below; then down.
+        let passes = [
+            (own.end - 1, self.part.above, 0, self.part.below),
+            (own.start, self.part.below, n[axis] - 1, self.part.above),
+        ];
+        for (send, to, recv, from) in passes {
+            if to.is_some() {
+                let mut k = 0;
+                layer_runs::<Q>(n, axis, send, |start, len| {
+                    self.halo_send[k..k + len].copy_from_slice(&self.f[start..start + len]);
+                    k += len;
+                });
+            }
+            self.comm
+                .shift(to.map(|r| (&self.halo_send[..], r)), from.map(|r| (&mut self.halo_recv[..], r)));
+            if from.is_some() {
+                let mut k = 0;
+                layer_runs::<Q>(n, axis, recv, |start, len| {
+                    self.f[start..start + len].copy_from_slice(&self.halo_recv[k..k + len]);
+                    k += len;
+                });
+            }
+        }
+    }
+
+    /// Advances one time step (every rank together). Allocates nothing.
     pub fn step(&mut self) -> Result<(), LbmError> {
         let kernel = plane_fn::<Q, L>(self.cfg.collision, self.cfg.body_force != [0.0; 3], self.cfg.smagorinsky > 0.0);
         let ctx = ctx::<Q>(&self.cfg, &self.plan, self.relax, self.velocity_scale);
         let (src, src_ext) = (&self.f[..], self.f.padded());
         let plane_len = Q * self.cfg.n[0] * self.cfg.n[1];
+        let (n, part) = (self.cfg.n, &self.part);
         self.f_next.par_chunks_mut(plane_len).enumerate().for_each(|(z, out)| {
             kernel(&ctx, src, src_ext, z, out);
-            apply_plane(&self.sponges, out, z, self.cfg.n, &self.plan.solid);
+            apply_plane(&self.sponges, out, z, n, part, &self.plan.solid);
         });
-        Self::link_forces(&ctx, src, self.cfg.segments, &mut self.segment_forces, &mut self.body_forces);
+        Self::link_forces(&ctx, src, &self.part, self.cfg.segments, &mut self.partial);
         std::mem::swap(&mut self.f, &mut self.f_next);
         self.finish_step()
     }
@@ -472,32 +681,25 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                 }
             }
         }
-        let (mut segment, mut body) = (vec![[0.0; 3]; self.bodies * self.cfg.segments], vec![[0.0; 3]; self.bodies]);
-        Self::link_forces(&ctx, &self.f, self.cfg.segments, &mut segment, &mut body);
-        (self.segment_forces, self.body_forces) = (segment, body);
+        Self::link_forces(&ctx, &self.f, &self.part, self.cfg.segments, &mut self.partial);
         for (z, plane) in next.chunks_mut(Q * nx * ny).enumerate() {
-            apply_plane(&self.sponges, plane, z, self.cfg.n, &self.plan.solid);
+            apply_plane(&self.sponges, plane, z, self.cfg.n, &self.part, &self.plan.solid);
         }
         self.f_next.copy_from_slice(&next);
         std::mem::swap(&mut self.f, &mut self.f_next);
         self.finish_step()
     }
 
+    /// After the populations of a step: the ghost layers, the forces, the checks.
     fn finish_step(&mut self) -> Result<(), LbmError> {
+        self.exchange();
+        self.total_forces();
         self.time += 1;
         if let Some(b) = self.body_forces.iter().position(|f| f.iter().any(|v| !v.is_finite())) {
-            let at = self
-                .plan
-                .links
-                .iter()
-                .find(|l| l.body as usize == b)
-                .map(|l| l.node as usize)
-                .unwrap_or(0);
-            let [nx, ny, _] = self.cfg.n;
             return Err(LbmError::Diverged3 {
                 step: self.time,
                 reason: format!("the force on body {b} is not finite"),
-                at: [at % nx, (at / nx) % ny, at / (nx * ny)],
+                at: self.first_link_of(b),
             });
         }
         if self.cfg.check_interval > 0 && self.time.is_multiple_of(self.cfg.check_interval) {
@@ -506,55 +708,90 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         Ok(())
     }
 
+    /// The global node of body `b`'s first link on this rank (where a force went wrong).
+    fn first_link_of(&self, b: usize) -> [usize; 3] {
+        let [nx, ny, _] = self.cfg.n;
+        let at = self
+            .plan
+            .links
+            .iter()
+            .find(|l| l.body as usize == b)
+            .map(|l| l.node as usize)
+            .unwrap_or(0);
+        self.part.global([at % nx, (at / nx) % ny, at / (nx * ny)])
+    }
+
     /// Scans every node for NaN, density out of `rho_bounds` or speed above `u_max`; names the
-    /// first offending node in node order.
+    /// first offending node in global node order (every rank the same).
     pub fn check(&self) -> Result<(), LbmError> {
         let [nx, ny, nz] = self.cfg.n;
         let [rho_lo, rho_hi] = self.cfg.rho_bounds;
         let u_max = self.cfg.u_max;
+        // (global node index, what, value) of this rank's first bad node.
         let bad = (0..ny * nz).into_par_iter().find_map_first(|r| {
             let (y, z) = (r % ny, r / ny);
             (0..nx).find_map(|x| {
-                if self.plan.solid[(z * ny + y) * nx + x] {
+                if self.plan.solid[(z * ny + y) * nx + x] || !self.part.owns([x, y, z]) {
                     return None;
                 }
                 let g = self.populations([x, y, z]);
-                let reason = if g.iter().any(|v| !v.is_finite()) {
-                    "NaN in the populations".to_string()
+                let (drho, j) = moments::<Q, L>(&g);
+                let rho = 1.0 + drho;
+                let u = (j[0] * j[0] + j[1] * j[1] + j[2] * j[2]).sqrt() / rho;
+                let what = if g.iter().any(|v| !v.is_finite()) {
+                    Bad::NaN
+                } else if rho < rho_lo {
+                    Bad::RhoLow(rho)
+                } else if rho > rho_hi {
+                    Bad::RhoHigh(rho)
+                } else if u > u_max {
+                    Bad::Speed(u)
                 } else {
-                    let (drho, j) = moments::<Q, L>(&g);
-                    let rho = 1.0 + drho;
-                    let u = (j[0] * j[0] + j[1] * j[1] + j[2] * j[2]).sqrt() / rho;
-                    if rho < rho_lo {
-                        format!("density {rho:.4} below {rho_lo}")
-                    } else if rho > rho_hi {
-                        format!("density {rho:.4} above {rho_hi}")
-                    } else if u > u_max {
-                        format!("lattice speed {u:.4} above {u_max} (Mach {:.2})", u * 3f32.sqrt())
-                    } else {
-                        return None;
-                    }
+                    return None;
                 };
-                Some((reason, [x, y, z]))
+                let [gx, gy, gz] = self.part.global([x, y, z]);
+                let [gnx, gny, _] = self.part.n_global;
+                Some(((gz * gny + gy) * gnx + gx, what))
             })
         });
-        match bad {
-            Some((reason, at)) => Err(LbmError::Diverged3 {
-                step: self.time,
-                reason,
-                at,
-            }),
-            None => Ok(()),
+        // Every rank's first, in rank slots: the one earliest in node order wins.
+        let size = self.comm.size();
+        let mut mine = vec![0.0f64; 3 * size];
+        if let Some((node, what)) = bad {
+            let (code, value) = what.code();
+            mine[3 * self.comm.rank()..3 * self.comm.rank() + 3].copy_from_slice(&[1.0 + node as f64, code, value]);
         }
+        let mut all = vec![0.0f64; 3 * size];
+        self.comm.sum(&mine, &mut all);
+        let first = all.chunks(3).filter(|c| c[0] > 0.0).min_by(|a, b| a[0].total_cmp(&b[0]));
+        let Some(c) = first else { return Ok(()) };
+        let node = c[0] as usize - 1;
+        let [gnx, gny, _] = self.part.n_global;
+        let reason = match Bad::from_code(c[1], c[2] as f32) {
+            Bad::NaN => "NaN in the populations".to_string(),
+            Bad::RhoLow(rho) => format!("density {rho:.4} below {rho_lo}"),
+            Bad::RhoHigh(rho) => format!("density {rho:.4} above {rho_hi}"),
+            Bad::Speed(u) => format!("lattice speed {u:.4} above {u_max} (Mach {:.2})", u * 3f32.sqrt()),
+        };
+        Err(LbmError::Diverged3 {
+            step: self.time,
+            reason,
+            at: [node % gnx, (node / gnx) % gny, node / (gnx * gny)],
+        })
     }
 
     /// Sets face `face` (`2 a` the low end of axis `a`, `2 a + 1` the high end) to a velocity
     /// face of lattice velocity `u` from the next step on (a gust at the inlet); refused for a
     /// face that is not a velocity face.
     pub fn set_face_velocity(&mut self, face: usize, u: [f64; 3]) -> Result<(), LbmError> {
-        match self.cfg.faces.0.get(face) {
+        match self.global_cfg.faces.0.get(face) {
             Some(Face::Velocity(_)) => {
-                self.cfg.faces.0[face] = Face::Velocity(u.map(|v| v as f32));
+                let v = Face::Velocity(u.map(|v| v as f32));
+                self.global_cfg.faces.0[face] = v.clone();
+                // A rank whose end of the axis is a ghost layer has no such face.
+                if matches!(self.cfg.faces.0[face], Face::Velocity(_)) {
+                    self.cfg.faces.0[face] = v;
+                }
                 Ok(())
             }
             other => Err(LbmError::Config {
@@ -576,7 +813,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         let dx = self.cfg.grid.dx;
         for l in self.plan.links.iter_mut().filter(|l| l.body as usize == b) {
             let n = l.node as usize;
-            let p = self.cfg.grid.position([n % nx, (n / nx) % ny, n / (nx * ny)]);
+            let p = self.cfg.grid.position(self.part.global([n % nx, (n / nx) % ny, n / (nx * ny)]));
             let c = L::C_REF[l.k as usize];
             let at = [0, 1, 2].map(|a| p[a] - l.q as f64 * c[a] as f64 * dx);
             l.uw = u(at).map(|v| v as f32);
@@ -585,29 +822,37 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
 
     /// Mass the moving-wall terms of body `b`'s links inject per step (lattice units): over its
     /// links `6 w_k c_k . u_w`, divided by `2 q` where the interpolated bounce-back does
-    /// (`q >= 1/2`). Zero for a wall moving along itself; a jet's outflow otherwise.
+    /// (`q >= 1/2`). Zero for a wall moving along itself; a jet's outflow otherwise. Summed as
+    /// the forces are (per index along the split axis, then in order).
     pub fn wall_mass_source(&self, b: usize) -> f64 {
-        let mut m = 0.0f64;
+        let [nx, ny, _] = self.cfg.n;
+        let axis = self.part.axis;
+        let mut per_index = vec![0.0f64; self.part.n_global[axis]];
         for l in self.plan.links.iter().filter(|l| l.body as usize == b) {
+            let n = l.node as usize;
+            let p = [n % nx, (n / nx) % ny, n / (nx * ny)];
             let k = l.k as usize;
             let c = L::C_REF[k];
             let cu: f64 = (0..3).map(|a| c[a] as f64 * l.uw[a] as f64).sum();
             let term = 6.0 * L::W_REF[k] as f64 * cu;
-            m += if l.q < 0.5 { term } else { term / (2.0 * l.q as f64) };
+            per_index[self.part.global_index(p[axis])] += if l.q < 0.5 { term } else { term / (2.0 * l.q as f64) };
         }
-        m
+        let mut summed = vec![0.0; per_index.len()];
+        self.comm.sum(&per_index, &mut summed);
+        summed.iter().sum()
     }
 
     /// Density and velocity at the physical point `x`, trilinear between the eight nodes
-    /// around it (wrapping along periodic axes). Solid nodes count as resting fluid.
+    /// around it (wrapping along periodic axes). Solid nodes count as resting fluid. Split over
+    /// ranks, the rank owning the first of the eight interpolates and the others add zeros.
     pub fn probe(&self, x: [f64; 3]) -> Result<(f64, [f64; 3]), LbmError> {
-        let g = self.cfg.grid;
+        let g = self.global_cfg.grid;
         let mut base = [0usize; 3];
         let mut frac = [0.0f64; 3];
         for a in 0..3 {
-            let n = self.cfg.n[a];
+            let n = self.global_cfg.n[a];
             let t = (x[a] - g.origin[a]) / g.dx;
-            let periodic = self.cfg.faces.periodic_axis(a);
+            let periodic = self.global_cfg.faces.periodic_axis(a);
             let hi = if periodic { n as f64 } else { (n - 1) as f64 };
             if !(0.0..=hi).contains(&t) {
                 return Err(LbmError::Config {
@@ -629,12 +874,15 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         }
         let (mut rho, mut u) = (0.0, [0.0; 3]);
         for corner in 0..8 {
+            if !self.owns(base) {
+                break;
+            }
             let mut w = 1.0;
             let mut p = [0usize; 3];
             for a in 0..3 {
                 let up = (corner >> a) & 1;
                 w *= if up == 1 { frac[a] } else { 1.0 - frac[a] };
-                p[a] = (base[a] + up) % self.cfg.n[a];
+                p[a] = (base[a] + up) % self.global_cfg.n[a];
             }
             if w == 0.0 {
                 continue;
@@ -649,7 +897,12 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                 u[a] += w * v[a];
             }
         }
-        Ok((rho, u))
+        if !self.part.is_split() {
+            return Ok((rho, u));
+        }
+        let mut summed = [0.0; 4];
+        self.comm.sum(&[rho, u[0], u[1], u[2]], &mut summed);
+        Ok((summed[0], [summed[1], summed[2], summed[3]]))
     }
 
     /// The populations (for checkpoints and tests).

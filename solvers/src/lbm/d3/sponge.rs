@@ -6,6 +6,7 @@
 
 use super::collision::equilibrium;
 use super::lattice::Lattice3;
+use super::part::Part;
 
 /// One absorbing layer.
 #[derive(Clone, Debug, PartialEq)]
@@ -56,27 +57,34 @@ impl Sponge3Plan {
     }
 }
 
-/// Applies every layer to the post-collision populations of plane `z` (`plane[(i ny + y) nx + x]`).
-/// Solid nodes are left alone. Allocates nothing.
-pub(crate) fn apply_plane(plans: &[Sponge3Plan], plane: &mut [f32], z: usize, n: [usize; 3], solid: &[bool]) {
+/// Applies every layer to the post-collision populations of plane `z` (`plane[(i ny + y) nx + x]`)
+/// of this rank's box of `n` nodes (its slab of the global box, `part`). Solid nodes are left
+/// alone. Allocates nothing.
+pub(crate) fn apply_plane(plans: &[Sponge3Plan], plane: &mut [f32], z: usize, n: [usize; 3], part: &Part, solid: &[bool]) {
     let [nx, ny, _] = n;
+    let ng = part.n_global;
+    // Local index along each axis of global index `g` (unwrapped: a ghost layer may be left
+    // out, the exchange overwrites it).
+    let offset = |a: usize| if a == part.axis { part.offset } else { 0 };
     for p in plans {
-        // The nodes of the layer along its axis, all of them along the others.
+        // The local nodes of the layer along its axis, all of them along the others.
         let range = |a: usize| {
-            if a != p.face / 2 {
-                0..n[a]
+            let (lo, hi) = if a != p.face / 2 {
+                return 0..n[a];
             } else if p.face.is_multiple_of(2) {
-                0..p.width.min(n[a])
+                (0, p.width.min(ng[a]))
             } else {
-                n[a].saturating_sub(p.width)..n[a]
-            }
+                (ng[a].saturating_sub(p.width), ng[a])
+            };
+            let local = |g: usize| (g as isize - offset(a)).clamp(0, n[a] as isize) as usize;
+            local(lo)..local(hi)
         };
         if !range(2).contains(&z) {
             continue;
         }
         for y in range(1) {
             for x in range(0) {
-                let s = p.sigma([x, y, z], n);
+                let s = p.sigma(part.global([x, y, z]), ng);
                 if s == 0.0 || solid[(z * ny + y) * nx + x] {
                     continue;
                 }

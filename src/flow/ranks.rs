@@ -1,0 +1,41 @@
+//! hgym over MPI ranks, the single-program way: `mpirun -np N hgym-mpi COMMAND` runs the same
+//! command on every rank. The 3D lattice-Boltzmann flows split their boxes over the ranks
+//! ([`hgym_solvers::lbm::d3::Lbm3::new_split`]); everything they report (forces, probes, slices,
+//! the blow-up scan) is summed over the ranks bitwise as one process would compute it, so every
+//! rank takes the same decisions (agents, seeds, episode ends) without talking about them. Only
+//! rank 0 prints and writes files. The 2D flows run whole on every rank.
+//!
+//! The binary that starts MPI is `hgym-mpi` (the `mpi` feature, `make mpi`); `hgym` is one
+//! process and needs no MPI library.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use hgym_solvers::comm::{Comm, Solo};
+
+static RANK: AtomicUsize = AtomicUsize::new(0);
+static SIZE: AtomicUsize = AtomicUsize::new(1);
+
+/// Records this process's rank among `size` (called once by the binary after starting MPI).
+pub fn set(rank: usize, size: usize) {
+    RANK.store(rank, Ordering::Relaxed);
+    SIZE.store(size.max(1), Ordering::Relaxed);
+}
+
+/// `(rank, size)`; `(0, 1)` without MPI.
+pub fn rank() -> (usize, usize) {
+    (RANK.load(Ordering::Relaxed), SIZE.load(Ordering::Relaxed))
+}
+
+/// Whether this process prints and writes files (rank 0, or the only process).
+pub fn leader() -> bool {
+    rank().0 == 0
+}
+
+/// The ranks a 3D solver splits its box over: all of them under MPI, this process otherwise.
+pub fn comm() -> Box<dyn Comm> {
+    #[cfg(feature = "mpi")]
+    if rank().1 > 1 {
+        return Box::new(hgym_solvers::comm::MpiComm);
+    }
+    Box::new(Solo)
+}
