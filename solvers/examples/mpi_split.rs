@@ -80,73 +80,63 @@ fn main() -> ExitCode {
         return ExitCode::FAILURE;
     };
     let world = universe.world();
-    let (rank, size) = (world.rank(), world.size());
-    let bench: Option<usize> = std::env::args().skip_while(|a| a != "--bench").nth(1).and_then(|v| v.parse().ok());
+    match check(world.rank(), world.size() as usize) {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::FAILURE,
+        Err(e) => {
+            eprintln!("rank {}: {e}", world.rank());
+            ExitCode::FAILURE
+        }
+    }
+}
 
+/// The comparison on every rank (judged on rank 0), then the bench if asked for.
+fn check(rank: i32, size: usize) -> Result<bool, String> {
+    let bench: Option<usize> = std::env::args().skip_while(|a| a != "--bench").nth(1).and_then(|v| v.parse().ok());
     let n = [48, 20, 16];
     let steps = 40;
-    let split = match run(n, steps, Box::new(MpiComm)) {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("rank {rank}: {e}");
-            return ExitCode::FAILURE;
-        }
-    };
+    let split = run(n, steps, Box::new(MpiComm))?;
     if rank == 0 {
-        let one = match run(n, steps, Box::new(Solo)) {
-            Ok(r) => r,
-            Err(e) => {
-                eprintln!("one process: {e}");
-                return ExitCode::FAILURE;
-            }
-        };
-        let same = one.forces == split.forces && one.probes == split.probes && one.mass == split.mass;
-        println!(
-            "{n:?} box split along {} over {size} ranks, {steps} steps: forces, probes and mass {}",
-            ["x", "y", "z"][split_axis(n)],
-            if same {
-                "bitwise the same as one process"
-            } else {
-                "DIFFER from one process"
-            }
-        );
-        if !same {
-            let differ = [
-                ("forces", one.forces != split.forces),
-                ("probes", one.probes != split.probes),
-                ("mass", one.mass != split.mass),
-            ];
-            let names: Vec<&str> = differ.iter().filter(|d| d.1).map(|d| d.0).collect();
-            eprintln!("differing: {}", names.join(", "));
-            return ExitCode::FAILURE;
+        let one = run(n, steps, Box::new(Solo))?;
+        let differ: Vec<&str> = [
+            ("forces", one.forces != split.forces),
+            ("probes", one.probes != split.probes),
+            ("mass", one.mass != split.mass),
+        ]
+        .iter()
+        .filter(|d| d.1)
+        .map(|d| d.0)
+        .collect();
+        let axis = ["x", "y", "z"][split_axis(n)];
+        if !differ.is_empty() {
+            println!(
+                "{n:?} box split along {axis} over {size} ranks, {steps} steps: {} DIFFER from one process",
+                differ.join(", ")
+            );
+            return Ok(false);
         }
+        println!("{n:?} box split along {axis} over {size} ranks, {steps} steps: forces, probes and mass bitwise the same as one process");
     }
 
     if let Some(steps) = bench {
         let n = [192, 96, 96];
-        let r = match run(n, steps, Box::new(MpiComm)) {
-            Ok(r) => r,
-            Err(e) => {
-                eprintln!("rank {rank}: {e}");
-                return ExitCode::FAILURE;
-            }
-        };
+        let r = run(n, steps, Box::new(MpiComm))?;
         if rank == 0 {
-            let cells = n.iter().product::<usize>() as f64;
+            let cells = n.iter().product::<usize>();
             // A layer (all Q populations of one node plane across the split axis) each way across
             // each of the size - 1 boundaries between slabs (the split axis, y, is not periodic).
-            let layer_bytes = 19 * 4 * n.iter().product::<usize>() / n[split_axis(n)];
+            let layer_bytes = 19 * 4 * cells / n[split_axis(n)];
             println!(
                 "bench {n:?} D3Q19, {size} rank(s) x {} thread(s): {steps} steps in {:.2} s, {:.1} MLUPS; \
                  {:.2} MB sent per step in all ({} boundaries, one {:.2} MB layer each way)",
                 rayon::current_num_threads(),
                 r.seconds,
-                cells * steps as f64 / r.seconds / 1e6,
-                (2 * (size as usize - 1) * layer_bytes) as f64 / 1e6,
+                cells as f64 * steps as f64 / r.seconds / 1e6,
+                (2 * (size - 1) * layer_bytes) as f64 / 1e6,
                 size - 1,
                 layer_bytes as f64 / 1e6
             );
         }
     }
-    ExitCode::SUCCESS
+    Ok(true)
 }

@@ -136,6 +136,22 @@ pub fn calibrate(
     })
 }
 
+/// `FamilySpec::calibrate` of the lattice-Boltzmann families: checks the table first, then
+/// `measure`s, records the entry for `id` at `level` and returns what it recorded, and where.
+pub(crate) fn measure_and_record(
+    id: &str,
+    level: Level,
+    actions: usize,
+    table: Option<&std::path::Path>,
+    measure: impl FnOnce() -> Result<Entry, EnvError>,
+) -> Result<(String, std::path::PathBuf), super::family::CalibrateError> {
+    let table = super::family::calibration_table::<Entry>(actions, table, TABLE_PATH)?;
+    let entry = measure()?;
+    let summary = entry.summary(id);
+    crate::report::table::record(&table, &[(table_key(id, level), entry)])?;
+    Ok((summary, table))
+}
+
 /// The statistics of an [`Entry`] (hash and level left empty) from `actions` uncontrolled
 /// intervals of `env` after `reset(0)`: the raw observation `raw(env)` at the end of each, and
 /// the mean total `C_D`, `C_L` of `info`.

@@ -261,16 +261,21 @@ impl LbmEnv {
             .map(|d| d.join(format!("flow-{}-{}.f32", self.level.name(), &hash[..16])))
     }
 
-    /// The developed flow: from memory, from the disk cache, or by spinning up.
-    fn attractor(&mut self) -> Result<Vec<f32>, EnvError> {
-        if let Some(a) = &self.attractor {
-            return Ok(a.clone());
+    /// Makes sure `self.attractor` holds the developed flow: from the disk cache, or by spinning
+    /// up (`reset` then copies it into the solver from there, once).
+    fn develop(&mut self) -> Result<(), EnvError> {
+        if self.attractor.is_none() {
+            let want = self.solver.populations().len() + self.thermal.as_ref().map_or(0, |t| t.populations().len());
+            self.attractor = match self.cache_file().and_then(|p| super::spin_up::load_state(&p, want)) {
+                Some(state) => Some(state),
+                None => Some(self.spin_up()?),
+            };
         }
-        let want = self.solver.populations().len() + self.thermal.as_ref().map_or(0, |t| t.populations().len());
-        if let Some(state) = self.cache_file().and_then(|p| super::spin_up::load_state(&p, want)) {
-            self.attractor = Some(state.clone());
-            return Ok(state);
-        }
+        Ok(())
+    }
+
+    /// The developed flow by spinning up (stored in the disk cache).
+    fn spin_up(&mut self) -> Result<Vec<f32>, EnvError> {
         // Spin up from the uniform flow with a transverse kick just behind the last body (fluid
         // that a body says starts at rest, at rest).
         let u = self.spec.lattice_velocity;
@@ -300,7 +305,6 @@ impl LbmEnv {
         if let Some(path) = self.cache_file() {
             super::spin_up::store_state(&path, &state);
         }
-        self.attractor = Some(state.clone());
         Ok(state)
     }
 
@@ -373,7 +377,8 @@ impl Env for LbmEnv {
     }
 
     fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
-        let state = self.attractor()?;
+        self.develop()?;
+        let state = self.attractor.as_deref().unwrap_or_default();
         let n_flow = self.solver.populations().len();
         // An oscillating inflow continues its phase from the end of the spin-up.
         let time = if self.spec.inflow.is_some() {
@@ -609,11 +614,9 @@ impl FamilySpec for EnvSpec {
         table: Option<&Path>,
         progress: &mut dyn FnMut(usize),
     ) -> Result<(String, PathBuf), CalibrateError> {
-        let table = super::family::calibration_table::<super::calibrate::Entry>(actions, table, super::calibrate::TABLE_PATH)?;
-        let entry = super::calibrate::calibrate(self, level, actions, cache, &mut |k, _| progress(k))?;
-        let summary = entry.summary(&self.id);
-        crate::report::table::record(&table, &[(super::calibrate::table_key(&self.id, level), entry)])?;
-        Ok((summary, table))
+        super::calibrate::measure_and_record(&self.id, level, actions, table, || {
+            super::calibrate::calibrate(self, level, actions, cache, &mut |k, _| progress(k))
+        })
     }
 
     fn as_any(&self) -> &dyn std::any::Any {

@@ -228,21 +228,20 @@ impl LbmEnv3 {
         })
     }
 
-    /// The developed flow: from memory, from the disk cache, or by spinning up from the free
-    /// stream with a kick behind the last body, modulated along the span so that 3D modes grow
-    /// (fluid that a body says starts at rest, the cavity's, at rest).
-    fn attractor(&mut self) -> Result<Vec<f32>, EnvError> {
-        if let Some(a) = &self.attractor {
-            return Ok(a.clone());
+    /// The developed flow into `self.attractor` (`reset` copies it into the solver from there):
+    /// from the disk cache, or by spinning up from the free stream with a kick behind the last
+    /// body, modulated along the span so that 3D modes grow (fluid that a body says starts at
+    /// rest, the cavity's, at rest).
+    fn develop(&mut self) -> Result<(), EnvError> {
+        if self.attractor.is_some() {
+            return Ok(());
         }
         let want = self.solver.populations().len();
         let cached = self.cache_file().and_then(|p| super::spin_up::load_state(&p, want));
         // Under MPI the ranks spin up together unless every one of them has its slab cached.
         if self.solver.all_ranks(cached.is_some()) {
-            if let Some(state) = cached {
-                self.attractor = Some(state.clone());
-                return Ok(state);
-            }
+            self.attractor = cached;
+            return Ok(());
         }
         let u = self.spec.lattice_velocity;
         let centers: Vec<[f64; 2]> = self.spec.bodies.iter().map(|b| b.center()).collect();
@@ -269,8 +268,8 @@ impl LbmEnv3 {
         if let Some(path) = self.cache_file() {
             super::spin_up::store_state(&path, &state);
         }
-        self.attractor = Some(state.clone());
-        Ok(state)
+        self.attractor = Some(state);
+        Ok(())
     }
 
     /// Raw probe values, `(u, v, w, p)` per probe and segment (units of U and rho U^2).
@@ -352,8 +351,9 @@ impl Env for LbmEnv3 {
     }
 
     fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
-        let state = self.attractor()?;
-        self.solver.set_populations(&state, 0).map_err(backend)?;
+        self.develop()?;
+        let state = self.attractor.as_deref().unwrap_or_default();
+        self.solver.set_populations(state, 0).map_err(backend)?;
         self.a_old = vec![0.0; self.spec.act_dim()];
         let rest = self.a_old.clone();
         self.actuate(&rest);
@@ -582,20 +582,18 @@ impl FamilySpec for Env3Spec {
         table: Option<&Path>,
         progress: &mut dyn FnMut(usize),
     ) -> Result<(String, PathBuf), CalibrateError> {
-        let table = super::family::calibration_table::<super::calibrate::Entry>(actions, table, super::calibrate::TABLE_PATH)?;
-        let mut raw = self.clone();
-        raw.normalization = Default::default();
-        raw.episode_actions = actions.max(1);
-        let mut env = LbmEnv3::new(raw, level, cache)?;
-        let entry = super::calibrate::statistics(&mut env, &self.id, actions, LbmEnv3::raw_observation, &mut |k, _| progress(k))?;
-        let entry = super::calibrate::Entry {
-            spec_hash: physics_hash(self),
-            level: level.name().into(),
-            ..entry
-        };
-        let summary = entry.summary(&self.id);
-        crate::report::table::record(&table, &[(super::calibrate::table_key(&self.id, level), entry)])?;
-        Ok((summary, table))
+        super::calibrate::measure_and_record(&self.id, level, actions, table, || {
+            let mut raw = self.clone();
+            raw.normalization = Default::default();
+            raw.episode_actions = actions.max(1);
+            let mut env = LbmEnv3::new(raw, level, cache)?;
+            let entry = super::calibrate::statistics(&mut env, &self.id, actions, LbmEnv3::raw_observation, &mut |k, _| progress(k))?;
+            Ok(super::calibrate::Entry {
+                spec_hash: physics_hash(self),
+                level: level.name().into(),
+                ..entry
+            })
+        })
     }
 
     fn as_any(&self) -> &dyn std::any::Any {

@@ -754,20 +754,27 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                 Some(((gz * gny + gy) * gnx + gx, what))
             })
         });
-        // Every rank's first, in rank slots: the one earliest in node order wins.
-        let size = self.comm.size();
-        let mut mine = vec![0.0f64; 3 * size];
-        if let Some((node, what)) = bad {
-            let (code, value) = what.code();
-            mine[3 * self.comm.rank()..3 * self.comm.rank() + 3].copy_from_slice(&[1.0 + node as f64, code, value]);
-        }
-        let mut all = vec![0.0f64; 3 * size];
-        self.comm.sum(&mine, &mut all);
-        let first = all.chunks(3).filter(|c| c[0] > 0.0).min_by(|a, b| a[0].total_cmp(&b[0]));
-        let Some(c) = first else { return Ok(()) };
-        let node = c[0] as usize - 1;
+        let (node, what) = if self.comm.size() == 1 {
+            match bad {
+                Some(b) => b,
+                None => return Ok(()),
+            }
+        } else {
+            // Every rank's first, in rank slots: the one earliest in node order wins.
+            let size = self.comm.size();
+            let mut mine = vec![0.0f64; 3 * size];
+            if let Some((node, what)) = bad {
+                let (code, value) = what.code();
+                mine[3 * self.comm.rank()..3 * self.comm.rank() + 3].copy_from_slice(&[1.0 + node as f64, code, value]);
+            }
+            let mut all = vec![0.0f64; 3 * size];
+            self.comm.sum(&mine, &mut all);
+            let first = all.chunks(3).filter(|c| c[0] > 0.0).min_by(|a, b| a[0].total_cmp(&b[0]));
+            let Some(c) = first else { return Ok(()) };
+            (c[0] as usize - 1, Bad::from_code(c[1], c[2] as f32))
+        };
         let [gnx, gny, _] = self.part.n_global;
-        let reason = match Bad::from_code(c[1], c[2] as f32) {
+        let reason = match what {
             Bad::NaN => "NaN in the populations".to_string(),
             Bad::RhoLow(rho) => format!("density {rho:.4} below {rho_lo}"),
             Bad::RhoHigh(rho) => format!("density {rho:.4} above {rho_hi}"),
