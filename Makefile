@@ -104,6 +104,7 @@ mpi: build
 	$(MPIRUN) -np 2 $(MPI_SPLIT)
 	$(MPIRUN) -np 3 $(MPI_SPLIT)
 	HGYM=$(HGYM) HGYM_MPI=$(HGYM_MPI) MPIRUN="$(MPIRUN)" scripts/mpi_check.sh tests/cases/sphere_mpi.toml
+	HGYM=$(HGYM) HGYM_MPI=$(HGYM_MPI) MPIRUN="$(MPIRUN)" scripts/mpi_train_check.sh tests/cases/mpi_train.toml
 
 roofline: build $(CARGO_TARGET_DIR)/stream_copy
 	HGYM=$(HGYM) C_COPY=$(CARGO_TARGET_DIR)/stream_copy scripts/roofline.sh

@@ -19,6 +19,11 @@ macro_rules! println {
     ($($arg:tt)*) => { $crate::cli::out::write_out(format_args!("{}\n", format_args!($($arg)*))) };
 }
 
+macro_rules! eprintln {
+    () => { $crate::cli::out::write_err(format_args!("\n")) };
+    ($($arg:tt)*) => { $crate::cli::out::write_err(format_args!("{}\n", format_args!($($arg)*))) };
+}
+
 #[path = "cli/mod.rs"]
 mod cli;
 use hgym::validate::ValidateError;
@@ -126,7 +131,7 @@ fn main() -> ExitCode {
         hgym::flow::ranks::set(world.rank() as usize, world.size() as usize);
         universe
     };
-    let cli = match Cli::try_parse() {
+    let mut cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
             let code = if e.use_stderr() { 2 } else { 0 };
@@ -140,6 +145,10 @@ fn main() -> ExitCode {
         }
         return ExitCode::from(2);
     }
+    let scratch = match cli::ranks::scatter_outputs(&mut cli.command) {
+        Ok(s) => s,
+        Err(e) => return failed(e, None),
+    };
     hgym::env::spin_up::observe_spin_ups(cli::progress::spin_up_progress);
     let result = match cli.command {
         Command::Validate(args) => cli::validate::run(args),
@@ -159,14 +168,26 @@ fn main() -> ExitCode {
     match result {
         Ok(Outcome::Ok) => ExitCode::SUCCESS,
         Ok(Outcome::CheckFailed) => ExitCode::from(1),
-        Err(e) => {
-            match hgym::flow::ranks::rank() {
-                (0, _) => eprintln!("error: {e:#}"),
-                (r, _) => eprintln!("error (rank {r}): {e:#}"),
-            }
-            ExitCode::from(if is_bad_input(&e) { 2 } else { 1 })
-        }
+        Err(e) => failed(e, scratch),
     }
+}
+
+/// Reports `e` and ends: exit code 2 for bad input, else 1. On several MPI ranks every rank
+/// reports its own error and the job is aborted: ranks that did not fail would otherwise wait
+/// in the solver's next exchange for the one that did.
+fn failed(e: anyhow::Error, scratch: Option<cli::ranks::Scratch>) -> ExitCode {
+    let code = if is_bad_input(&e) { 2 } else { 1 };
+    match hgym::flow::ranks::rank() {
+        (0, 1) => std::eprintln!("error: {e:#}"),
+        (r, _) => std::eprintln!("error (rank {r}): {e:#}"),
+    }
+    drop(scratch);
+    #[cfg(feature = "mpi")]
+    if hgym::flow::ranks::rank().1 > 1 {
+        use mpi::traits::Communicator;
+        mpi::topology::SimpleCommunicator::world().abort(code);
+    }
+    ExitCode::from(code as u8)
 }
 
 /// The one place that decides the exit code of an error: 2 when anything in its chain is the
@@ -200,12 +221,16 @@ fn is_bad_input(e: &anyhow::Error) -> bool {
     })
 }
 
-/// Why a command cannot run on several MPI ranks yet, if it cannot: only validation keeps its
-/// files to rank 0 so far; the others would write them from every rank.
+/// Why a command cannot run on several MPI ranks, if it cannot: those that step flows (`validate`,
+/// `train`, `eval`, `run`) can; the others gain nothing from ranks.
 fn refused_under_mpi(command: &Command) -> Option<String> {
     let size = hgym::flow::ranks::rank().1;
-    (size > 1 && !matches!(command, Command::Validate(_)))
-        .then(|| format!("on {size} MPI ranks hgym-mpi runs `validate` only so far; run this command with `hgym` (one process)"))
+    (size > 1
+        && !matches!(
+            command,
+            Command::Validate(_) | Command::Train(_) | Command::Eval(_) | Command::Run(_)
+        ))
+    .then(|| format!("on {size} MPI ranks hgym-mpi runs validate, train, eval and run; run this command with `hgym` (one process)"))
 }
 
 /// A command-line mistake the CLI itself finds (exit code 2).

@@ -1,6 +1,7 @@
-//! Standard output for the commands: `print!` and `println!` in the binary are these (see
-//! `main.rs`), so that a reader closing the pipe early (`hgym envs | head -1`) ends the program
-//! quietly with exit code 0 instead of a panic.
+//! Standard output and error for the commands: `print!`, `println!`, `eprint!` and `eprintln!`
+//! in the binary are these (see `main.rs`), so that a reader closing the pipe early (`hgym envs |
+//! head -1`) ends the program quietly with exit code 0 instead of a panic, and so that under MPI
+//! only rank 0 speaks (the others run the same command; `main` reports their errors itself).
 
 use std::io::Write;
 
@@ -17,5 +18,13 @@ pub fn write_out(args: std::fmt::Arguments) {
         }
         eprintln!("error: cannot write to standard output: {e}");
         std::process::exit(1);
+    }
+}
+
+/// Writes `args` to standard error, on rank 0 only (a failed write to standard error has nowhere
+/// to be reported and is dropped).
+pub fn write_err(args: std::fmt::Arguments) {
+    if hgym::flow::ranks::leader() {
+        let _ = std::io::stderr().lock().write_fmt(args);
     }
 }

@@ -40,6 +40,13 @@ pub struct RunArgs {
     threads: Option<usize>,
 }
 
+impl RunArgs {
+    /// Under MPI, ranks other than 0 write here (see `cli::ranks`).
+    pub fn write_into(&mut self, scratch: &super::ranks::Scratch) {
+        self.out = scratch.output(&self.out);
+    }
+}
+
 pub fn run(args: RunArgs) -> Result<Outcome> {
     let config = match &args.config {
         None => hgym::train::config::TrainConfig::default(),
@@ -75,11 +82,7 @@ pub fn run(args: RunArgs) -> Result<Outcome> {
     let pb = Progress::new(args.steps as u64, spec.id());
     super::train::install_interrupt();
     let summary = pool
-        .install(|| {
-            hgym::env::rollout::rollout(&spec, &opts, &mut |k, _| pb.set_position(k as u64), &|| {
-                super::train::INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst)
-            })
-        })
+        .install(|| hgym::env::rollout::rollout(&spec, &opts, &mut |k, _| pb.set_position(k as u64), &super::train::interrupted))
         .with_context(|| format!("running {}", spec.id()))?;
     pb.finish_and_clear();
     println!(

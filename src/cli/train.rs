@@ -123,7 +123,31 @@ pub struct EvalArgs {
     threads: Option<usize>,
 }
 
+impl TrainArgs {
+    /// Under MPI, ranks other than 0 write here (see `cli::ranks`).
+    pub fn write_into(&mut self, scratch: &super::ranks::Scratch) -> Result<()> {
+        self.out = scratch.output(&self.out);
+        if let Some(dir) = &self.resume {
+            self.resume = Some(scratch.copy_of(dir)?);
+        }
+        Ok(())
+    }
+}
+
+impl EvalArgs {
+    /// Under MPI, ranks other than 0 write here (see `cli::ranks`).
+    pub fn write_into(&mut self, scratch: &super::ranks::Scratch) {
+        self.out = self.out.as_deref().map(|o| scratch.output(o));
+    }
+}
+
 pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Whether Ctrl-C was pressed, on any rank under MPI (a collective there: the training loops
+/// ask between rounds and actions, at the same points on every rank).
+pub fn interrupted() -> bool {
+    hgym::flow::ranks::any(INTERRUPTED.load(Ordering::SeqCst))
+}
 static SIGNALS: AtomicUsize = AtomicUsize::new(0);
 
 /// First Ctrl-C: finish the current round, write the checkpoint, exit 130. Second: exit now
@@ -358,7 +382,7 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
                             );
                         }
                     },
-                    &|| INTERRUPTED.load(Ordering::SeqCst),
+                    &interrupted,
                 )
             })
             .map_err(train_error)
@@ -656,7 +680,7 @@ pub fn protocol_run(pool: &rayon::ThreadPool, mut opts: TrainOptions, label: &st
                         eprintln!("{label}: {} / {} samples, return {:.2}", pr.samples, pr.total, pr.train_return);
                     }
                 },
-                &|| INTERRUPTED.load(Ordering::SeqCst),
+                &interrupted,
             )
         })
         .map_err(train_error)

@@ -275,8 +275,7 @@ impl LbmEnv3 {
     /// Raw probe values, `(u, v, w, p)` per probe and segment (units of U and rho U^2).
     pub fn raw_observation(&self) -> Result<Vec<f64>, EnvError> {
         let mut obs = Vec::with_capacity(self.spec.obs_dim());
-        for p in &self.probes {
-            let (rho, u) = self.solver.probe(*p).map_err(backend)?;
+        for (rho, u) in self.solver.probes(&self.probes).map_err(backend)? {
             obs.extend(u.map(|v| self.units.velocity(v)));
             obs.push(self.units.pressure(rho));
         }
@@ -472,13 +471,14 @@ impl super::fields::FlowFields for LbmEnv3 {
         let d = &self.spec.domain;
         let extent = [d.x[0], d.x[1], d.y[0], d.y[1]];
         let (mut u, mut v) = (vec![f32::NAN; nx * ny], vec![f32::NAN; nx * ny]);
-        for (k, w) in self.solver.velocity_plane(nz / 2).iter().enumerate() {
+        let plane = self.solver.velocity_plane(nz / 2);
+        for (k, w) in plane.iter().enumerate() {
             if let Some(w) = w {
                 u[k] = self.units.velocity(w[0]) as f32;
                 v[k] = self.units.velocity(w[1]) as f32;
             }
         }
-        let w = crate::flow::field::mid_span_vorticity(&self.solver, &self.units, extent).values;
+        let w = crate::flow::plane_vorticity(&plane, [nx, ny], &self.units, extent).values;
         crate::data::field::Snapshot {
             episode: 0,
             step: 0,

@@ -34,11 +34,10 @@ pub fn vorticity_field(s: &D2q9, units: &Units, extent: [f64; 4]) -> Field {
     Field { nx, ny, extent, values: w }
 }
 
-/// Spanwise vorticity `w_z = dv/dx - du/dy` in the mid-span plane of a 3D flow (central
-/// differences, units of U/L; NaN in bodies).
-pub fn mid_span_vorticity(s: &super::LbmFlow3, units: &Units, extent: [f64; 4]) -> Field {
-    let [nx, ny, nz] = s.n();
-    let plane = s.velocity_plane(nz / 2);
+/// Spanwise vorticity `w_z = dv/dx - du/dy` in a z plane of a 3D flow, `plane` as
+/// [`super::LbmFlow3::velocity_plane`] gathers it, `nx` by `ny` (central differences, units of
+/// U/L; NaN in bodies).
+pub fn plane_vorticity(plane: &[Option<[f64; 3]>], [nx, ny]: [usize; 2], units: &Units, extent: [f64; 4]) -> Field {
     let mut w = vec![f32::NAN; nx * ny];
     // Solid nodes count as resting fluid in the differences.
     let u = |x: usize, y: usize| plane[y * nx + x].unwrap_or([0.0; 3]);

@@ -29,7 +29,7 @@ use hgym_solvers::lbm::{Collision, LbmError};
 
 pub use build::LbmFlow;
 pub use domain::{BoundaryKind, BoundarySpec, DomainSpec, EdgeName, SpongeSpec};
-pub use field::{mid_span_vorticity, vorticity_field, Field};
+pub use field::{plane_vorticity, vorticity_field, Field};
 pub use geometry::GeometrySpec;
 pub use inlet::{InletSpec, Profile, VelocityReference};
 pub use level::{Level, ResolutionSpec, UnknownLevel};

@@ -39,3 +39,20 @@ pub fn comm() -> Box<dyn Comm> {
     }
     Box::new(Solo)
 }
+
+/// Whether `yes` holds on any rank. A collective: every rank calls it at the same point of the
+/// same program (a Ctrl-C reaches the ranks at different moments; deciding on `any` of them
+/// keeps them stepping together).
+pub fn any(yes: bool) -> bool {
+    if rank().1 == 1 {
+        return yes;
+    }
+    let mut count = [0.0];
+    comm().sum(&[f64::from(u8::from(yes))], &mut count);
+    count[0] > 0.0
+}
+
+/// Waits until every rank gets here.
+pub fn barrier() {
+    any(false);
+}

@@ -186,6 +186,11 @@ impl LbmFlow3 {
         each!(self, s => s.probe(x))
     }
 
+    /// [`Self::probe`] at each point (one message over the ranks for all of them).
+    pub fn probes(&self, xs: &[[f64; 3]]) -> Result<Vec<(f64, [f64; 3])>, LbmError> {
+        each!(self, s => s.probes(xs))
+    }
+
     pub fn time(&self) -> u64 {
         each!(self, s => s.time())
     }

@@ -13,7 +13,7 @@ use hgym_solvers::lbm::LbmError;
 
 use super::case::{flow_error, Level, LoadedCase};
 use super::ValidateError;
-use crate::flow::{mid_span_vorticity, vorticity_field, Field, FlowError, FlowPlan, FlowSetup, LbmFlow, LbmFlow3};
+use crate::flow::{plane_vorticity, vorticity_field, Field, FlowError, FlowPlan, FlowSetup, LbmFlow, LbmFlow3};
 use hgym_solvers::lbm::Units;
 
 /// Most lattice steps a case may run (its force series hold 8 bytes per step and series).
@@ -258,7 +258,10 @@ impl Solver {
                 s.sync();
                 vorticity_field(s.coarse(), units, extent)
             }
-            Solver::Span(s) => mid_span_vorticity(s, units, extent),
+            Solver::Span(s) => {
+                let [nx, ny, nz] = s.n();
+                plane_vorticity(&s.velocity_plane(nz / 2), [nx, ny], units, extent)
+            }
         }
     }
 }

@@ -853,6 +853,25 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     /// around it (wrapping along periodic axes). Solid nodes count as resting fluid. Split over
     /// ranks, the rank owning the first of the eight interpolates and the others add zeros.
     pub fn probe(&self, x: [f64; 3]) -> Result<(f64, [f64; 3]), LbmError> {
+        Ok(self.probes(&[x])?[0])
+    }
+
+    /// [`Self::probe`] at each point of `xs`, summed over the ranks in one message.
+    pub fn probes(&self, xs: &[[f64; 3]]) -> Result<Vec<(f64, [f64; 3])>, LbmError> {
+        let mut local = Vec::with_capacity(4 * xs.len());
+        for x in xs {
+            local.extend(self.probe_local(*x)?);
+        }
+        let mut summed = local.clone();
+        if self.part.is_split() {
+            self.comm.sum(&local, &mut summed);
+        }
+        Ok(summed.chunks_exact(4).map(|v| (v[0], [v[1], v[2], v[3]])).collect())
+    }
+
+    /// `(rho, u)` at `x` as [`Self::probe`] computes it if this rank owns the first corner,
+    /// zeros otherwise.
+    fn probe_local(&self, x: [f64; 3]) -> Result<[f64; 4], LbmError> {
         let g = self.global_cfg.grid;
         let mut base = [0usize; 3];
         let mut frac = [0.0f64; 3];
@@ -904,12 +923,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                 u[a] += w * v[a];
             }
         }
-        if !self.part.is_split() {
-            return Ok((rho, u));
-        }
-        let mut summed = [0.0; 4];
-        self.comm.sum(&[rho, u[0], u[1], u[2]], &mut summed);
-        Ok((summed[0], [summed[1], summed[2], summed[3]]))
+        Ok([rho, u[0], u[1], u[2]])
     }
 
     /// The populations (for checkpoints and tests).

@@ -1,0 +1,80 @@
+//! Commands on several MPI ranks (`mpirun -np N hgym-mpi train|eval|run|validate ...`): every
+//! rank runs the whole command and takes the same decisions (see `hgym::flow::ranks`); rank 0
+//! writes the results where the command line says, every other rank into a scratch folder of
+//! its own, deleted when the command ends, so that the code writing files needs no rank checks.
+//! A run to resume is copied into the scratch folder first: every rank then continues from rank
+//! 0's checkpoint (each rank checkpoints on its own clock, so their own copies could differ).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+
+/// A rank's scratch folder, removed on drop.
+pub struct Scratch(PathBuf);
+
+impl Scratch {
+    /// `<temp>/hgym-rank<r>-<pid>`, empty.
+    fn new(rank: usize) -> Result<Self> {
+        let dir = std::env::temp_dir().join(format!("hgym-rank{rank}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).with_context(|| format!("cannot create the scratch folder {}", dir.display()))?;
+        Ok(Self(dir))
+    }
+
+    /// Where this rank writes what rank 0 writes to `out`.
+    pub fn output(&self, out: &Path) -> PathBuf {
+        self.0.join("out").join(out.file_name().unwrap_or(out.as_os_str()))
+    }
+
+    /// A copy of the run folder `dir` (to resume) inside the scratch folder.
+    pub fn copy_of(&self, dir: &Path) -> Result<PathBuf> {
+        let to = self.0.join("resume").join(dir.file_name().unwrap_or(dir.as_os_str()));
+        copy_dir(dir, &to).with_context(|| format!("copying the run folder {} to resume it on this rank", dir.display()))?;
+        Ok(to)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Points the outputs of `command` into a scratch folder on every rank but 0, then waits until
+/// every rank is there (so that rank 0 changes nothing another rank is still copying). `None`
+/// on one process and on rank 0.
+pub fn scatter_outputs(command: &mut crate::Command) -> Result<Option<Scratch>> {
+    let (rank, size) = hgym::flow::ranks::rank();
+    if size == 1 {
+        return Ok(None);
+    }
+    let scratch = if rank == 0 {
+        None
+    } else {
+        let s = Scratch::new(rank)?;
+        match command {
+            crate::Command::Train(a) => a.write_into(&s)?,
+            crate::Command::Eval(a) => a.write_into(&s),
+            crate::Command::Run(a) => a.write_into(&s),
+            // Validation writes from rank 0 only (`hgym::validate`); the others are refused.
+            _ => {}
+        }
+        Some(s)
+    };
+    hgym::flow::ranks::barrier();
+    Ok(scratch)
+}
+
+/// Copies the folder `from` (files and subfolders) to `to`.
+fn copy_dir(from: &Path, to: &Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(to)?;
+    for entry in std::fs::read_dir(from)? {
+        let entry = entry?;
+        let target = to.join(entry.file_name());
+        if entry.file_type()?.is_dir() {
+            copy_dir(&entry.path(), &target)?;
+        } else {
+            std::fs::copy(entry.path(), &target)?;
+        }
+    }
+    Ok(())
+}
