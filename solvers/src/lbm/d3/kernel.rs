@@ -13,9 +13,9 @@
 use super::super::collision::Relax;
 pub(crate) use super::super::kernel::Special;
 use super::super::kernel::{nt_rows_possible, store_fence, stream_aligned};
-use super::collision::{collide, collide_chunk, Ends, CHUNK};
+use super::collision::{collide, collide_chunk, moments, Ends, CHUNK};
 use super::lattice::Lattice3;
-use super::sides::{face_value, Faces};
+use super::sides::{face_source, face_value, face_value_planned, Faces};
 
 /// A link from fluid node `node` whose streaming source in direction `k` (the node `node - c_k`)
 /// is inside a body; the wall is at fraction `q` of the way towards it.
@@ -28,6 +28,69 @@ pub(crate) struct Link {
     /// Wall velocity at the crossing, lattice units.
     pub uw: [f32; 3],
     pub body: u16,
+}
+
+/// What enters a special fluid node `k`-wards from beyond a face of the box, planned once:
+/// population index `src` of the step's source copied (periodic, wall and free-slip faces; see
+/// [`face_source`]), or [`FacePull::COMPUTED`] for velocity and outlet faces, whose value
+/// [`face_value`] computes from the populations of the step.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FacePull {
+    pub src: u32,
+    pub k: u8,
+}
+
+impl FacePull {
+    pub const COMPUTED: u32 = u32::MAX;
+}
+
+/// The moments `(rho - 1, j)` of the nodes of the outer layer of each face whose entering values
+/// are computed (velocity: `rho` of the node itself; outlet: the moments of the node across the
+/// face, which lies in the same layer), gathered once per step instead of once per entering
+/// direction. Node `p` of face `f` is at [`FaceMoments::at`].
+#[derive(Clone, Debug, Default)]
+pub(crate) struct FaceMoments(pub [Vec<[f32; 4]>; 6]);
+
+impl FaceMoments {
+    /// Room for the computed faces of `faces` on `n` nodes.
+    pub fn new(n: [usize; 3], faces: &Faces) -> Self {
+        FaceMoments(std::array::from_fn(|f| {
+            let a = f / 2;
+            if faces.0[f].is_computed() {
+                vec![[0.0; 4]; n[(a + 1) % 3] * n[(a + 2) % 3]]
+            } else {
+                Vec::new()
+            }
+        }))
+    }
+
+    /// Index of node `p` in the layer of face `f`.
+    #[inline(always)]
+    pub fn at(n: [usize; 3], f: usize, p: [usize; 3]) -> usize {
+        let a = f / 2;
+        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+        p[c] * n[b] + p[b]
+    }
+
+    /// Gathers the moments of every computed face's layer from `src`.
+    pub fn fill<const Q: usize, L: Lattice3<Q>>(&mut self, n: [usize; 3], src: &[f32]) {
+        for (f, layer) in self.0.iter_mut().enumerate() {
+            let a = f / 2;
+            let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+            for vc in 0..n[c] {
+                for vb in 0..n[b] {
+                    let mut p = [0; 3];
+                    p[a] = if f % 2 == 0 { 0 } else { n[a] - 1 };
+                    p[b] = vb;
+                    p[c] = vc;
+                    let Some(m) = layer.get_mut(vc * n[b] + vb) else { continue };
+                    let g: [f32; Q] = std::array::from_fn(|i| src[index::<Q>(n, p, i)]);
+                    let (drho, j) = moments::<Q, L>(&g);
+                    *m = [drho, j[0], j[1], j[2]];
+                }
+            }
+        }
+    }
 }
 
 /// Index of population `i` of node `p` on a grid of `n` nodes: `((z Q + i) ny + y) nx + x`.
@@ -52,6 +115,12 @@ pub(crate) struct Ctx<'a> {
     /// (next to a non-periodic face) are specials from end to end.
     pub row_bulk: &'a [bool],
     pub links: &'a [Link],
+    /// The face pulls of special `s` are `pulls[pull_start[s] .. pull_start[s + 1]]`.
+    pub pulls: &'a [FacePull],
+    pub pull_start: &'a [u32],
+    /// `(rho - 1, j)` of every node of the outer layer of each velocity and outlet face, from
+    /// the step's source (empty for the other faces; see [`FaceMoments`]).
+    pub face_moments: &'a FaceMoments,
     /// Write the bulk with non-temporal stores (arrays larger than the caches).
     pub stream_stores: bool,
 }
@@ -163,6 +232,38 @@ pub(crate) fn gather<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p: [u
     g
 }
 
+/// [`gather`] with the face values planned ([`FacePull`]): the same values, without working
+/// out the face, the mirror direction and the source node of each one every step.
+#[inline(always)]
+fn gather_planned<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p: [usize; 3], pulls: &[FacePull], links: &[Link]) -> [f32; Q] {
+    let mut g = [0.0f32; Q];
+    for (i, gi) in g.iter_mut().enumerate() {
+        if let Some(s) = c.neighbour(p, L::C_REF[i].map(|v| -v)) {
+            *gi = src[c.idx::<Q>(s, i)];
+        }
+    }
+    for fp in pulls {
+        g[fp.k as usize] = match fp.src {
+            FacePull::COMPUTED => face_value_planned::<Q, L>(c, src, p, fp.k as usize),
+            i => src[i as usize],
+        };
+    }
+    for l in links {
+        g[l.k as usize] = bouzidi::<Q, L>(c, src, p, l);
+    }
+    g
+}
+
+/// The face pulls of fluid node `p`: one per direction whose source lies beyond a face.
+pub(crate) fn plan_pulls<const Q: usize, L: Lattice3<Q>>(c: &Ctx, p: [usize; 3], out: &mut Vec<FacePull>) {
+    for i in 0..Q {
+        if c.neighbour(p, L::C_REF[i].map(|v| -v)).is_none() {
+            let src = face_source::<Q, L>(c, p, i).map_or(FacePull::COMPUTED, |v| v as u32);
+            out.push(FacePull { src, k: i as u8 });
+        }
+    }
+}
+
 /// The bulk of row `(y, z)`: every node `x = 0 .. nx-1` in chunks of [`CHUNK`] nodes, collided
 /// by [`collide_chunk`] into an L1-resident buffer (at most 27 x 128 x 4 = 14 KB) and written
 /// out, with non-temporal stores when the arrays are larger than the caches (no
@@ -248,8 +349,9 @@ pub(crate) fn plane<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: 
         if nx >= 3 && c.row_bulk[r] {
             bulk::<Q, L, OP, FORCED, LES>(c, src, src_ext, y, z, out, &mut buf);
         }
-        let specials = &c.specials[c.row_start[r] as usize..c.row_start[r + 1] as usize];
-        for sp in specials {
+        let first = c.row_start[r] as usize;
+        let specials = &c.specials[first..c.row_start[r + 1] as usize];
+        for (s, sp) in (first..).zip(specials) {
             let x = sp.x as usize;
             // A solid node, or a ghost node of a split box (the exchange fills it): zeros.
             if sp.solid {
@@ -259,7 +361,8 @@ pub(crate) fn plane<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: 
                 continue;
             }
             let links = &c.links[sp.link_start as usize..sp.link_end as usize];
-            let mut g = gather::<Q, L>(c, src, [x, y, z], links);
+            let pulls = &c.pulls[c.pull_start[s] as usize..c.pull_start[s + 1] as usize];
+            let mut g = gather_planned::<Q, L>(c, src, [x, y, z], pulls, links);
             collide::<Q, L, OP, FORCED, LES>(&mut g, c.relax, c.force);
             for (i, gi) in g.iter().enumerate() {
                 out[(i * ny + y) * nx + x] = *gi;

@@ -3,7 +3,7 @@
 //! [`Side`](crate::lbm::Side), written for any direction of a 3D lattice.
 
 use super::collision::moments;
-use super::kernel::Ctx;
+use super::kernel::{Ctx, FaceMoments};
 use super::lattice::Lattice3;
 
 /// What happens at one face of the box.
@@ -35,6 +35,12 @@ impl Face {
         }
     }
 
+    /// Whether what enters through the face is computed from the populations (velocity and
+    /// outlet faces), not copied.
+    pub(crate) fn is_computed(&self) -> bool {
+        matches!(self, Face::Velocity(_) | Face::Outlet)
+    }
+
     fn is_wall_like(&self) -> bool {
         matches!(self, Face::Wall | Face::FreeSlip | Face::Velocity(_))
     }
@@ -62,18 +68,18 @@ impl Faces {
     }
 }
 
-/// Value entering fluid node `p` in direction `k` whose source `p - c_k` lies outside the box.
+/// The face beyond which the source `p - c_k` of node `p` lies; at an edge or corner a wall wins
+/// over an outlet, then the last axis. `None` inside the box.
 #[inline]
-pub(crate) fn face_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p: [usize; 3], k: usize) -> f32 {
+fn crossed_face<const Q: usize, L: Lattice3<Q>>(c: &Ctx, p: [usize; 3], k: usize) -> Option<usize> {
     let ck = L::C_REF[k];
-    let s = [0, 1, 2].map(|a| p[a] as isize - ck[a] as isize);
-    // The faces crossed; at an edge or corner a wall wins over an outlet, then the last axis.
     let mut face: Option<usize> = None;
     for a in 0..3 {
-        if c.periodic[a] || (0..c.n[a] as isize).contains(&s[a]) {
+        let s = p[a] as isize - ck[a] as isize;
+        if c.periodic[a] || (0..c.n[a] as isize).contains(&s) {
             continue;
         }
-        let f = 2 * a + usize::from(s[a] >= 0);
+        let f = 2 * a + usize::from(s >= 0);
         let better = match face {
             None => true,
             Some(g) => c.faces.0[f].is_wall_like() || !c.faces.0[g].is_wall_like(),
@@ -82,22 +88,26 @@ pub(crate) fn face_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p
             face = Some(f);
         }
     }
+    face
+}
+
+/// Where the value entering fluid node `p` in direction `k` from beyond a face is copied from
+/// (an index into the populations), for the faces whose value is a copy: periodic, wall and
+/// free-slip. `None` for velocity and outlet faces, whose values [`face_value`] computes from
+/// the populations of the step. The fast kernel plans these once (`FacePull`).
+#[inline]
+pub(crate) fn face_source<const Q: usize, L: Lattice3<Q>>(c: &Ctx, p: [usize; 3], k: usize) -> Option<usize> {
     let opp = L::OPP_REF[k];
-    let Some(f) = face else {
-        // Not outside: cannot happen (a solid source inside the box always has a link).
-        return src[c.idx::<Q>(p, opp)];
+    // Not outside: cannot happen (a solid source inside the box always has a link).
+    let Some(f) = crossed_face::<Q, L>(c, p, k) else {
+        return Some(c.idx::<Q>(p, opp));
     };
     match &c.faces.0[f] {
-        Face::Periodic | Face::Wall => src[c.idx::<Q>(p, opp)],
-        Face::Velocity(u) => {
-            let g: [f32; Q] = std::array::from_fn(|i| src[c.idx::<Q>(p, i)]);
-            let rho = 1.0 + moments::<Q, L>(&g).0;
-            let cu = ck[0] as f32 * u[0] + ck[1] as f32 * u[1] + ck[2] as f32 * u[2];
-            src[c.idx::<Q>(p, opp)] + 6.0 * L::W_REF[k] * rho * cu * c.velocity_scale
-        }
+        Face::Periodic | Face::Wall => Some(c.idx::<Q>(p, opp)),
         Face::FreeSlip => {
             // Specular reflection: the population arriving with c_k left the neighbour along the
             // wall with its normal component reversed.
+            let ck = L::C_REF[k];
             let a = f / 2;
             let mut m = ck;
             m[a] = -m[a];
@@ -105,25 +115,89 @@ pub(crate) fn face_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p
             let mut d = ck.map(|v| -v);
             d[a] = 0;
             let b = c.neighbour(p, d).filter(|&b| !c.is_solid(b)).unwrap_or(p);
-            src[c.idx::<Q>(b, mirrored)]
+            Some(c.idx::<Q>(b, mirrored))
+        }
+        Face::Velocity(_) | Face::Outlet => None,
+    }
+}
+
+/// Value entering fluid node `p` in direction `k` whose source `p - c_k` lies outside the box.
+#[inline]
+pub(crate) fn face_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p: [usize; 3], k: usize) -> f32 {
+    if let Some(i) = face_source::<Q, L>(c, p, k) {
+        return src[i];
+    }
+    let ck = L::C_REF[k];
+    let opp = L::OPP_REF[k];
+    let f = crossed_face::<Q, L>(c, p, k).unwrap_or(0);
+    match &c.faces.0[f] {
+        Face::Velocity(u) => {
+            let g: [f32; Q] = std::array::from_fn(|i| src[c.idx::<Q>(p, i)]);
+            let rho = 1.0 + moments::<Q, L>(&g).0;
+            let cu = ck[0] as f32 * u[0] + ck[1] as f32 * u[1] + ck[2] as f32 * u[2];
+            src[c.idx::<Q>(p, opp)] + 6.0 * L::W_REF[k] * rho * cu * c.velocity_scale
         }
         Face::Outlet => {
-            // Zero gradient: the populations of the node across the face, clamped into the box.
-            let b = [0, 1, 2].map(|a| {
-                if c.periodic[a] {
-                    s[a].rem_euclid(c.n[a] as isize) as usize
-                } else {
-                    s[a].clamp(0, c.n[a] as isize - 1) as usize
-                }
-            });
-            let b = if c.is_solid(b) { p } else { b };
+            let b = outlet_node(c, p, ck);
             let g: [f32; Q] = std::array::from_fn(|i| src[c.idx::<Q>(b, i)]);
             let (drho, j) = moments::<Q, L>(&g);
-            let rho = 1.0 + drho;
-            let u = j.map(|v| v / rho);
-            let cu = 3.0 * (ck[0] as f32 * u[0] + ck[1] as f32 * u[1] + ck[2] as f32 * u[2]);
-            let shape = 1.0 + cu + 0.5 * cu * cu - 1.5 * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-            g[k] - drho * L::W_REF[k] * shape
+            outlet_value::<Q, L>(k, g[k], drho, j)
         }
+        // Copies: answered by `face_source` above.
+        Face::Periodic | Face::Wall | Face::FreeSlip => src[c.idx::<Q>(p, opp)],
     }
+}
+
+/// [`face_value`] for a velocity or outlet face, with the moments of the face's layer gathered
+/// for the step ([`FaceMoments`]): the same arithmetic on the same values.
+#[inline]
+pub(crate) fn face_value_planned<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p: [usize; 3], k: usize) -> f32 {
+    let ck = L::C_REF[k];
+    let f = crossed_face::<Q, L>(c, p, k).unwrap_or(0);
+    let layer = &c.face_moments.0[f];
+    match &c.faces.0[f] {
+        Face::Velocity(u) => {
+            let rho = 1.0 + layer[FaceMoments::at(c.n, f, p)][0];
+            let cu = ck[0] as f32 * u[0] + ck[1] as f32 * u[1] + ck[2] as f32 * u[2];
+            src[c.idx::<Q>(p, L::OPP_REF[k])] + 6.0 * L::W_REF[k] * rho * cu * c.velocity_scale
+        }
+        Face::Outlet => {
+            let b = outlet_node(c, p, ck);
+            let m = layer[FaceMoments::at(c.n, f, b)];
+            outlet_value::<Q, L>(k, src[c.idx::<Q>(b, k)], m[0], [m[1], m[2], m[3]])
+        }
+        _ => face_value::<Q, L>(c, src, p, k),
+    }
+}
+
+/// The node whose populations an outlet gives to `p` in direction `c_k`: across the face, clamped
+/// into the box (`p` itself if that one is solid).
+#[inline]
+fn outlet_node(c: &Ctx, p: [usize; 3], ck: [i32; 3]) -> [usize; 3] {
+    let b = [0, 1, 2].map(|a| {
+        let s = p[a] as isize - ck[a] as isize;
+        if c.periodic[a] {
+            s.rem_euclid(c.n[a] as isize) as usize
+        } else {
+            s.clamp(0, c.n[a] as isize - 1) as usize
+        }
+    });
+    if c.is_solid(b) {
+        p
+    } else {
+        b
+    }
+}
+
+/// Zero gradient across an outlet, shifted to `rho = 1`: `g_k - (rho - 1) w_k s_k(u)` of the
+/// node across the face, with its moments `(rho - 1, j)` and `s_k` the equilibrium's shape
+/// (`f^eq_k = rho w_k s_k(u)`).
+#[inline]
+fn outlet_value<const Q: usize, L: Lattice3<Q>>(k: usize, gk: f32, drho: f32, j: [f32; 3]) -> f32 {
+    let ck = L::C_REF[k];
+    let rho = 1.0 + drho;
+    let u = j.map(|v| v / rho);
+    let cu = 3.0 * (ck[0] as f32 * u[0] + ck[1] as f32 * u[1] + ck[2] as f32 * u[2]);
+    let shape = 1.0 + cu + 0.5 * cu * cu - 1.5 * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    gk - drho * L::W_REF[k] * shape
 }

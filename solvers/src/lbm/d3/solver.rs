@@ -8,7 +8,7 @@ use super::super::collision::{Collision, Relax, OP_BGK, OP_REG};
 use super::super::error::LbmError;
 use super::super::solver::STREAM_STORES_ABOVE_BYTES;
 use super::collision::{collide, equilibrium, moments};
-use super::kernel::{bouzidi, gather, index, plane, Ctx, Link, Special, PAD};
+use super::kernel::{bouzidi, gather, index, plan_pulls, plane, Ctx, FaceMoments, FacePull, Link, Special, PAD};
 use super::lattice::Lattice3;
 use super::part::Part;
 use super::sides::{Face, Faces};
@@ -166,6 +166,8 @@ pub struct Lbm3<const Q: usize, L: Lattice3<Q>> {
     /// One layer of populations across the split axis, sent and received after each step.
     halo_send: Vec<f32>,
     halo_recv: Vec<f32>,
+    /// The moments of the velocity and outlet faces' layers, gathered at the start of each step.
+    face_moments: FaceMoments,
     /// Per (body, segment, index along the split axis) force sums, before and after the ranks'
     /// sum: `[((b segments + s) n_axis + i) 3 + a]`.
     partial: Vec<f64>,
@@ -190,9 +192,43 @@ struct Plan {
     row_start: Vec<u32>,
     row_bulk: Vec<bool>,
     links: Vec<Link>,
+    pulls: Vec<FacePull>,
+    pull_start: Vec<u32>,
 }
 
-fn ctx<'a, const Q: usize>(cfg: &'a D3Config, plan: &'a Plan, relax: Relax, velocity_scale: f32) -> Ctx<'a> {
+impl Plan {
+    /// Plans the face pulls of every special fluid node (the faces of `cfg`).
+    fn plan_pulls<const Q: usize, L: Lattice3<Q>>(&mut self, cfg: &D3Config) -> Result<(), LbmError> {
+        if cfg.n.iter().product::<usize>() * Q >= FacePull::COMPUTED as usize {
+            return Err(LbmError::Config {
+                field: "n",
+                message: format!(
+                    "{} x {} x {} nodes x {Q} populations exceed the 2^32 a rank can index; split the box over more ranks",
+                    cfg.n[0], cfg.n[1], cfg.n[2]
+                ),
+            });
+        }
+        let (mut pulls, mut pull_start) = (Vec::new(), Vec::with_capacity(self.specials.len() + 1));
+        let none = FaceMoments::default();
+        let c = ctx::<Q>(cfg, self, &none, Relax::new(cfg.tau, 0.0), 1.0);
+        let [_, ny, _] = cfg.n;
+        for r in 0..self.row_start.len() - 1 {
+            let (y, z) = (r % ny, r / ny);
+            for sp in &self.specials[self.row_start[r] as usize..self.row_start[r + 1] as usize] {
+                pull_start.push(pulls.len() as u32);
+                if !sp.solid {
+                    plan_pulls::<Q, L>(&c, [sp.x as usize, y, z], &mut pulls);
+                }
+            }
+        }
+        pull_start.push(pulls.len() as u32);
+        self.pulls = pulls;
+        self.pull_start = pull_start;
+        Ok(())
+    }
+}
+
+fn ctx<'a, const Q: usize>(cfg: &'a D3Config, plan: &'a Plan, face_moments: &'a FaceMoments, relax: Relax, velocity_scale: f32) -> Ctx<'a> {
     Ctx {
         n: cfg.n,
         periodic: [0, 1, 2].map(|a| cfg.faces.periodic_axis(a)),
@@ -205,6 +241,9 @@ fn ctx<'a, const Q: usize>(cfg: &'a D3Config, plan: &'a Plan, relax: Relax, velo
         row_start: &plan.row_start,
         row_bulk: &plan.row_bulk,
         links: &plan.links,
+        pulls: &plan.pulls,
+        pull_start: &plan.pull_start,
+        face_moments,
         stream_stores: cfg
             .stream_stores
             .unwrap_or(cfg.n.iter().product::<usize>() * Q * 4 * 2 > STREAM_STORES_ABOVE_BYTES),
@@ -383,6 +422,16 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             }
         }
         row_start.push(specials.len() as u32);
+        let mut plan = Plan {
+            solid,
+            specials,
+            row_start,
+            row_bulk,
+            links,
+            pulls: Vec::new(),
+            pull_start: Vec::new(),
+        };
+        plan.plan_pulls::<Q, L>(&cfg)?;
         let layer = if part.is_split() { Q * cells / cfg.n[part.axis] } else { 0 };
         let sums = bodies.len() * cfg.segments * part.n_global[part.axis] * 3;
         Ok(Lbm3 {
@@ -398,13 +447,8 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             velocity_scale: 1.0,
             f: AlignedVec::zeros_padded(cells * Q, PAD),
             f_next: AlignedVec::zeros_padded(cells * Q, PAD),
-            plan: Plan {
-                solid,
-                specials,
-                row_start,
-                row_bulk,
-                links,
-            },
+            plan,
+            face_moments: FaceMoments::new(cfg.n, &cfg.faces),
             segment_forces: vec![[0.0; 3]; bodies.len() * cfg.segments],
             body_forces: vec![[0.0; 3]; bodies.len()],
             time: 0,
@@ -638,7 +682,8 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     /// Advances one time step (every rank together). Allocates nothing.
     pub fn step(&mut self) -> Result<(), LbmError> {
         let kernel = plane_fn::<Q, L>(self.cfg.collision, self.cfg.body_force != [0.0; 3], self.cfg.smagorinsky > 0.0);
-        let ctx = ctx::<Q>(&self.cfg, &self.plan, self.relax, self.velocity_scale);
+        self.face_moments.fill::<Q, L>(self.cfg.n, &self.f);
+        let ctx = ctx::<Q>(&self.cfg, &self.plan, &self.face_moments, self.relax, self.velocity_scale);
         let (src, src_ext) = (&self.f[..], self.f.padded());
         let plane_len = Q * self.cfg.n[0] * self.cfg.n[1];
         let (n, part) = (self.cfg.n, &self.part);
@@ -657,7 +702,8 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     pub fn step_reference(&mut self) -> Result<(), LbmError> {
         let forced = self.cfg.body_force != [0.0; 3];
         let les = self.cfg.smagorinsky > 0.0;
-        let ctx = ctx::<Q>(&self.cfg, &self.plan, self.relax, self.velocity_scale);
+        // The oracle computes what enters through the faces itself (`gather`, `face_value`).
+        let ctx = ctx::<Q>(&self.cfg, &self.plan, &self.face_moments, self.relax, self.velocity_scale);
         let collide_fn: fn(&mut [f32; Q], Relax, [f32; 3]) = monomorphised!(collide, self.cfg.collision, forced, les);
         let [nx, ny, nz] = self.cfg.n;
         let mut next = vec![0.0f32; self.f.len()];
