@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use hgym::env::family::CalibrateError;
-use hgym::env::{EnvSpec, Spec};
+use hgym::env::Spec;
 
 use super::progress::Progress;
 use crate::{thread_pool, Outcome, UsageError};
@@ -45,13 +45,13 @@ pub enum EnvsCommand {
 /// The committed deviations of `s`'s uncontrolled flow at `level` from the literature
 /// (`hgym validate --env ID --level L --record`), if measured on the flow registered now.
 fn fidelity_entry(s: &Spec, level: Level) -> Option<&'static hgym::fidelity::Entry> {
-    hgym::fidelity::committed(s.downcast::<EnvSpec>()?, level)
+    hgym::fidelity::committed(hgym::env::registry::lbm_flow(s)?, level)
 }
 
 /// `St -2.7% C_D +13.7%`; `-` without references (the Kolmogorov flows' check is `hgym validate
 /// kolmogorov`); `not measured`.
 fn fidelity(s: &Spec, level: Level) -> String {
-    match (s.downcast::<EnvSpec>(), fidelity_entry(s, level)) {
+    match (hgym::env::registry::lbm_flow(s), fidelity_entry(s, level)) {
         (_, Some(e)) => e.summary(),
         (Some(spec), None) if hgym::fidelity::has_reference(spec) => "not measured".into(),
         _ => "-".into(),

@@ -177,16 +177,27 @@ fn run_cases(cases: &[LoadedCase], args: &ValidateArgs, out: &std::path::Path) -
 /// `--env ID...`: each environment's flow with its family's references; `all`: every ID with
 /// references, each distinct flow run once and its row recorded for every ID that shares it.
 fn run_envs(args: &ValidateArgs) -> Result<Outcome> {
-    let specs = if args.envs.iter().any(|e| e == "all") {
-        hgym::env::registry::lbm_specs()
-            .into_iter()
-            .filter(fidelity::has_reference)
-            .collect()
+    use hgym::env::registry::{lbm_flow, LbmFlowSpec};
+    let all = hgym::env::registry::all();
+    let specs: Vec<&dyn LbmFlowSpec> = if args.envs.iter().any(|e| e == "all") {
+        all.iter().filter_map(lbm_flow).filter(|s| fidelity::has_reference(*s)).collect()
     } else {
-        args.envs.iter().map(|id| hgym::env::lbm_spec(id)).collect::<Result<Vec<_>, _>>()?
+        let mut specs = Vec::new();
+        for id in &args.envs {
+            let s = hgym::env::lookup(id)?;
+            let Some(flow) = all.iter().find(|a| a.id() == s.id()).and_then(lbm_flow) else {
+                return Err(hgym::env::EnvInputError::NotLbm {
+                    id: id.clone(),
+                    solver: s.solver(),
+                }
+                .into());
+            };
+            specs.push(flow);
+        }
+        specs
     };
-    let mut flows: Vec<(String, Vec<&hgym::env::EnvSpec>)> = Vec::new();
-    for s in &specs {
+    let mut flows: Vec<(String, Vec<&dyn LbmFlowSpec>)> = Vec::new();
+    for &s in &specs {
         let h = s.flow_setup().hash();
         match flows.iter_mut().find(|(k, _)| *k == h) {
             Some((_, ids)) => ids.push(s),
@@ -201,12 +212,12 @@ fn run_envs(args: &ValidateArgs) -> Result<Outcome> {
     let reports = run_cases(&loaded, args, &args.out.join("envs"))?;
     let mut rows = Vec::new();
     for (((_, ids), (_, case)), report) in flows.iter().zip(&cases).zip(&reports) {
-        for s in ids {
+        for &s in ids {
             let e = Entry::from_report(s, report, case);
             if !args.json {
-                println!("{:<30} {:<8} {} ({case}, {:?})", s.id, args.level.name(), e.summary(), e.status);
+                println!("{:<30} {:<8} {} ({case}, {:?})", s.id(), args.level.name(), e.summary(), e.status);
             }
-            rows.push((fidelity::key(&s.id, args.level), e));
+            rows.push((fidelity::key(s.id(), args.level), e));
         }
     }
     if args.json {

@@ -41,6 +41,48 @@ pub fn lookup(id: &str) -> Result<Spec, EnvInputError> {
     })
 }
 
+/// A lattice-Boltzmann environment's flow, 2D ([`EnvSpec`]) or 3D
+/// ([`Env3Spec`](super::spec3::Env3Spec)), as validation sees it.
+pub trait LbmFlowSpec {
+    fn id(&self) -> &str;
+    /// The uncontrolled flow the environment runs.
+    fn flow_setup(&self) -> crate::flow::FlowSetup;
+    /// The bundled validation case whose references judge this flow, if there is one.
+    fn validation_case(&self) -> Option<String>;
+}
+
+impl LbmFlowSpec for EnvSpec {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn flow_setup(&self) -> crate::flow::FlowSetup {
+        EnvSpec::flow_setup(self)
+    }
+    fn validation_case(&self) -> Option<String> {
+        EnvSpec::validation_case(self)
+    }
+}
+
+impl LbmFlowSpec for super::spec3::Env3Spec {
+    fn id(&self) -> &str {
+        &self.id
+    }
+    fn flow_setup(&self) -> crate::flow::FlowSetup {
+        super::spec3::Env3Spec::flow_setup(self)
+    }
+    fn validation_case(&self) -> Option<String> {
+        super::spec3::Env3Spec::validation_case(self)
+    }
+}
+
+/// The lattice-Boltzmann flow of a registered spec, 2D or 3D; `None` for the spectral ones.
+pub fn lbm_flow(spec: &Spec) -> Option<&dyn LbmFlowSpec> {
+    if let Some(s) = spec.downcast::<EnvSpec>() {
+        return Some(s);
+    }
+    spec.downcast::<super::spec3::Env3Spec>().map(|s| s as &dyn LbmFlowSpec)
+}
+
 /// The lattice-Boltzmann specs among all (those the flow layer builds).
 pub fn lbm_specs() -> Vec<EnvSpec> {
     all().iter().filter_map(|s| s.downcast::<EnvSpec>().cloned()).collect()

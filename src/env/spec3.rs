@@ -214,6 +214,12 @@ impl Env3Spec {
             .collect()
     }
 
+    /// The bundled 3D validation case of this flow (`sphere_re300`, `cube_re300`): the bodies
+    /// of their own, not the extruded 2D sections, whose cases are 2D.
+    pub fn validation_case(&self) -> Option<String> {
+        matches!(self.family.as_str(), "sphere" | "cube").then(|| format!("{}_re{}", self.family, self.reynolds.round() as i64))
+    }
+
     /// The flow this environment runs: a uniform rigid inlet and the span.
     pub fn flow_setup(&self) -> FlowSetup {
         FlowSetup {

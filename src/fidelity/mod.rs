@@ -18,7 +18,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::env::EnvSpec;
+use crate::env::registry::LbmFlowSpec;
 use crate::flow::Level;
 use crate::validate::{self, LoadedCase, Status, ValidateError, ValidationReport};
 
@@ -71,7 +71,7 @@ pub struct Entry {
 
 impl Entry {
     /// The row of a report of `spec`'s flow.
-    pub fn from_report(spec: &EnvSpec, report: &ValidationReport, case: &str) -> Entry {
+    pub fn from_report(spec: &dyn LbmFlowSpec, report: &ValidationReport, case: &str) -> Entry {
         let q = |name: &str| report.quantities.iter().find(|q| q.name == name);
         let measured = |name: &str| q(name).and_then(|q| q.measured);
         let deviation = |name: &str| q(name).and_then(|q| q.deviation);
@@ -117,38 +117,38 @@ pub fn table() -> &'static BTreeMap<String, Entry> {
 }
 
 /// The committed row of `spec` at `level`, if it was measured on the flow registered now.
-pub fn committed(spec: &EnvSpec, level: Level) -> Option<&'static Entry> {
+pub fn committed(spec: &dyn LbmFlowSpec, level: Level) -> Option<&'static Entry> {
     table()
-        .get(&key(&spec.id, level))
+        .get(&key(spec.id(), level))
         .filter(|e| e.flow_hash == spec.flow_setup().hash())
 }
 
 /// The validation case of `spec`'s own flow at its level: the family's bundled case (its
 /// quantities, references, times and kick) on the environment's flow, named `<ID>-<level>`.
-pub fn env_case(spec: &EnvSpec, level: Level) -> Result<(LoadedCase, String), FidelityError> {
+pub fn env_case(spec: &dyn LbmFlowSpec, level: Level) -> Result<(LoadedCase, String), FidelityError> {
     let no_reference = |reason: String| FidelityError::NoReference {
-        id: spec.id.clone(),
+        id: spec.id().to_string(),
         reason,
     };
     let case = spec
         .validation_case()
-        .ok_or_else(|| no_reference(format!("no 2D references for the '{}' family", spec.family)))?;
+        .ok_or_else(|| no_reference("no validation case for its family and Reynolds number".into()))?;
     let base = validate::bundled()?
         .into_iter()
         .find(|c| c.case.case.name == case)
         .ok_or_else(|| no_reference(format!("no bundled validation case '{case}'")))?;
-    let name = format!("{}-{}", spec.id, level.name());
+    let name = format!("{}-{}", spec.id(), level.name());
     let description = format!(
         "{}: the environment's uncontrolled flow at the {} level, against the references of {case}",
-        spec.id,
+        spec.id(),
         level.name()
     );
-    let loaded = base.on_flow(&spec.flow_setup(), &name, &description, &format!("env:{}", spec.id))?;
+    let loaded = base.on_flow(&spec.flow_setup(), &name, &description, &format!("env:{}", spec.id()))?;
     Ok((loaded, case))
 }
 
 /// Whether `spec`'s flow has a bundled case to compare with.
-pub fn has_reference(spec: &EnvSpec) -> bool {
+pub fn has_reference(spec: &dyn LbmFlowSpec) -> bool {
     let Some(case) = spec.validation_case() else {
         return false;
     };

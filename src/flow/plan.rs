@@ -33,20 +33,28 @@ fn mem_available(meminfo: &str) -> Option<f64> {
 /// fixed limit ([`MAX_NODES`] D2Q9 cells' worth) or the memory the machine has `available`,
 /// naming the limit that binds. Compared as floats: a huge domain must not wrap when cast to
 /// `usize`, and a NaN size is refused.
-fn fits_in_memory(cells: &str, need: f64, bytes: usize, available: Option<f64>) -> Result<(), FlowError> {
+/// `need` is the bytes of the whole grid, held by `ranks` processes in equal shares (a 3D box
+/// split over MPI ranks; 1 otherwise): each share must fit.
+fn fits_in_memory(cells: &str, need: f64, bytes: usize, ranks: usize, available: Option<f64>) -> Result<(), FlowError> {
     let max_bytes = (MAX_NODES * BYTES_PER_NODE) as f64;
-    let message = if !(need <= max_bytes) {
+    let share = need / ranks.max(1) as f64;
+    let per_rank = if ranks > 1 {
+        format!(" per rank of {ranks}")
+    } else {
+        String::new()
+    };
+    let message = if !(share <= max_bytes) {
         format!(
-            "{cells} cells would need {} GB of populations ({bytes} bytes per cell); the limit is {} cells ({:.1} GB): use a coarser level or a smaller domain",
-            count(need / 1e9),
+            "{cells} cells would need {} GB of populations{per_rank} ({bytes} bytes per cell); the limit is {} cells ({:.1} GB) per process: use a coarser level, a smaller domain or more ranks",
+            count(share / 1e9),
             (max_bytes as usize) / bytes,
             max_bytes / 1e9
         )
-    } else if let Some(have) = available.filter(|&have| need > have) {
+    } else if let Some(have) = available.filter(|&have| share > have) {
         format!(
-            "{cells} cells need {:.1} GB of populations, more than the {:.1} GB this machine has available; \
-             use a coarser level, a smaller domain, or a machine with more memory",
-            need / 1e9,
+            "{cells} cells need {:.1} GB of populations{per_rank}, more than the {:.1} GB this machine has available; \
+             use a coarser level, a smaller domain, more ranks or a machine with more memory",
+            share / 1e9,
             have / 1e9
         )
     } else {
@@ -200,7 +208,9 @@ impl FlowSetup {
             Some(nz) => format!("{} x {} x {nz}", count(nx_f), count(ny_f)),
             None => format!("{} x {}", count(nx_f), count(ny_f)),
         };
-        fits_in_memory(&cells, nx_f * ny_f * nz_f * bytes as f64, bytes, available_memory())?;
+        // A 3D box is split over the MPI ranks (`flow::ranks`); a 2D grid runs whole on each.
+        let ranks = if nz.is_some() { super::ranks::rank().1 } else { 1 };
+        fits_in_memory(&cells, nx_f * ny_f * nz_f * bytes as f64, bytes, ranks, available_memory())?;
         let (nx, ny) = (nx_f.round() as usize, ny_f.round() as usize);
         if nx < 8 || ny < 8 {
             return Err(FlowError::Invalid {
@@ -274,10 +284,18 @@ mod tests {
     /// sizes; one that fits, or a machine whose memory cannot be read, passes.
     #[test]
     fn refuses_grids_beyond_the_available_memory() {
-        let err = fits_in_memory("320 x 192 x 192", 1.8e9, 152, Some(1.0e9)).unwrap_err().to_string();
+        let err = fits_in_memory("320 x 192 x 192", 1.8e9, 152, 1, Some(1.0e9))
+            .unwrap_err()
+            .to_string();
         assert!(err.starts_with("`resolution`"), "{err}");
         assert!(err.contains("1.8 GB") && err.contains("1.0 GB"), "{err}");
-        assert!(fits_in_memory("320 x 192 x 192", 1.8e9, 152, Some(2.0e9)).is_ok());
-        assert!(fits_in_memory("320 x 192 x 192", 1.8e9, 152, None).is_ok());
+        assert!(fits_in_memory("320 x 192 x 192", 1.8e9, 152, 1, Some(2.0e9)).is_ok());
+        assert!(fits_in_memory("320 x 192 x 192", 1.8e9, 152, 1, None).is_ok());
+        // Split over 2 ranks, each holds half.
+        assert!(fits_in_memory("320 x 192 x 192", 1.8e9, 152, 2, Some(1.0e9)).is_ok());
+        let err = fits_in_memory("320 x 192 x 192", 1.8e9, 152, 2, Some(0.5e9))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("0.9 GB of populations per rank of 2"), "{err}");
     }
 }
