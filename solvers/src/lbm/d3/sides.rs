@@ -133,9 +133,7 @@ pub(crate) fn face_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p
     match &c.faces.0[f] {
         Face::Velocity(u) => {
             let g: [f32; Q] = std::array::from_fn(|i| src[c.idx::<Q>(p, i)]);
-            let rho = 1.0 + moments::<Q, L>(&g).0;
-            let cu = ck[0] as f32 * u[0] + ck[1] as f32 * u[1] + ck[2] as f32 * u[2];
-            src[c.idx::<Q>(p, opp)] + 6.0 * L::W_REF[k] * rho * cu * c.velocity_scale
+            velocity_value::<Q, L>(c, k, g[opp], moments::<Q, L>(&g).0, u)
         }
         Face::Outlet => {
             let b = outlet_node(c, p, ck);
@@ -157,9 +155,8 @@ pub(crate) fn face_value_planned<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &
     let layer = &c.face_moments.0[f];
     match &c.faces.0[f] {
         Face::Velocity(u) => {
-            let rho = 1.0 + layer[FaceMoments::at(c.n, f, p)][0];
-            let cu = ck[0] as f32 * u[0] + ck[1] as f32 * u[1] + ck[2] as f32 * u[2];
-            src[c.idx::<Q>(p, L::OPP_REF[k])] + 6.0 * L::W_REF[k] * rho * cu * c.velocity_scale
+            let drho = layer[FaceMoments::at(c.n, f, p)][0];
+            velocity_value::<Q, L>(c, k, src[c.idx::<Q>(p, L::OPP_REF[k])], drho, u)
         }
         Face::Outlet => {
             let b = outlet_node(c, p, ck);
@@ -168,6 +165,16 @@ pub(crate) fn face_value_planned<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &
         }
         _ => face_value::<Q, L>(c, src, p, k),
     }
+}
+
+/// Half-way bounce-back from a moving face: `g_opp + 6 w_k rho c_k.u` (the face velocity `u`
+/// times the solver's velocity scale), with the node's own `rho - 1`.
+#[inline]
+fn velocity_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, k: usize, g_opp: f32, drho: f32, u: &[f32; 3]) -> f32 {
+    let ck = L::C_REF[k];
+    let rho = 1.0 + drho;
+    let cu = ck[0] as f32 * u[0] + ck[1] as f32 * u[1] + ck[2] as f32 * u[2];
+    g_opp + 6.0 * L::W_REF[k] * rho * cu * c.velocity_scale
 }
 
 /// The node whose populations an outlet gives to `p` in direction `c_k`: across the face, clamped
