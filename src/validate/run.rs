@@ -114,10 +114,13 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
     let side = if case.flow.perturbation < 0.0 { -1.0 } else { 1.0 };
     let ramp = case.inlet.ramp;
     let start_u = if ramp > 0.0 { 0.0 } else { 1.0 };
-    solver.init_with(&|x, y| {
-        let r2 = ((x - center[0] - l) / l).powi(2) + ((y - center[1] - side * 0.25 * l) / l).powi(2);
-        (1.0, start_u * setup.inlet_velocity(y), kick * (-4.0 * r2).exp())
-    });
+    solver.init_with(
+        &|x, y| {
+            let r2 = ((x - center[0] - l) / l).powi(2) + ((y - center[1] - side * 0.25 * l) / l).powi(2);
+            (1.0, start_u * setup.inlet_velocity(y), kick * (-4.0 * r2).exp())
+        },
+        setup.span.as_ref(),
+    );
 
     let total = plan.total_steps;
     let mut t = Vec::with_capacity(total as usize);
@@ -204,14 +207,23 @@ impl Solver {
         }
     }
 
-    /// Every node at `field(x, y) = (rho, u, v)` (uniform along the span).
-    fn init_with(&mut self, field: &dyn Fn(f64, f64) -> (f64, f64, f64)) {
+    /// Every node at `field(x, y) = (rho, u, v)`; along a periodic span the transverse `v`
+    /// (the kick) is modulated by `1 + 0.5 sin(2 pi (z - z0) / L_z)`, as the 3D environments'
+    /// spin-up does: a kick uniform along a periodic span keeps an extruded flow exactly
+    /// two-dimensional forever. Other spans (a sphere's, a cube's) take it uniform.
+    fn init_with(&mut self, field: &dyn Fn(f64, f64) -> (f64, f64, f64), span: Option<&crate::flow::SpanSpec>) {
         match self {
             Solver::Flat(s) => s.init_with(field),
-            Solver::Span(s) => s.init_with(|p| {
-                let (rho, u, v) = field(p[0], p[1]);
-                (rho, [u, v, 0.0])
-            }),
+            Solver::Span(s) => {
+                let wave = span
+                    .filter(|sp| sp.boundary == crate::flow::BoundaryKind::Periodic)
+                    .map(|sp| (sp.z[0], sp.length()));
+                s.init_with(|p| {
+                    let (rho, u, v) = field(p[0], p[1]);
+                    let along = wave.map_or(1.0, |(z0, lz)| 1.0 + 0.5 * (2.0 * std::f64::consts::PI * (p[2] - z0) / lz).sin());
+                    (rho, [u, v * along, 0.0])
+                })
+            }
         }
     }
 
