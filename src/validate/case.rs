@@ -45,6 +45,7 @@ pub const BUNDLED: &[(&str, &str)] = &[
     ("square_re200.toml", include_str!("../../benchmarks/validation/square_re200.toml")),
     ("square_re1000.toml", include_str!("../../benchmarks/validation/square_re1000.toml")),
     ("sphere_re100.toml", include_str!("../../benchmarks/validation/sphere_re100.toml")),
+    ("sphere_re300.toml", include_str!("../../benchmarks/validation/sphere_re300.toml")),
 ];
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -262,6 +263,7 @@ impl LoadedCase {
         case.resolution = setup.resolution.clone();
         case.sponge = setup.sponges.clone();
         case.refinement = setup.refinement.clone();
+        case.span = setup.span.clone();
         let json = serde_json::to_string(&case).map_err(|e| bad(name, "case", e.to_string()))?;
         let loaded = LoadedCase {
             case,
