@@ -75,6 +75,9 @@ impl FaceMoments {
     /// Gathers the moments of every computed face's layer from `src`.
     pub fn fill<const Q: usize, L: Lattice3<Q>>(&mut self, n: [usize; 3], src: &[f32]) {
         for (f, layer) in self.0.iter_mut().enumerate() {
+            if layer.is_empty() {
+                continue;
+            }
             let a = f / 2;
             let (b, c) = ((a + 1) % 3, (a + 2) % 3);
             for vc in 0..n[c] {
@@ -83,7 +86,7 @@ impl FaceMoments {
                     p[a] = if f % 2 == 0 { 0 } else { n[a] - 1 };
                     p[b] = vb;
                     p[c] = vc;
-                    let Some(m) = layer.get_mut(vc * n[b] + vb) else { continue };
+                    let m = &mut layer[vc * n[b] + vb];
                     let g: [f32; Q] = std::array::from_fn(|i| src[index::<Q>(n, p, i)]);
                     let (drho, j) = moments::<Q, L>(&g);
                     *m = [drho, j[0], j[1], j[2]];

@@ -908,10 +908,13 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         for x in xs {
             local.extend(self.probe_local(*x)?);
         }
-        let mut summed = local.clone();
-        if self.part.is_split() {
+        let summed = if self.part.is_split() {
+            let mut summed = vec![0.0; local.len()];
             self.comm.sum(&local, &mut summed);
-        }
+            summed
+        } else {
+            local
+        };
         Ok(summed.chunks_exact(4).map(|v| (v[0], [v[1], v[2], v[3]])).collect())
     }
 
