@@ -49,6 +49,7 @@ fn each_3d_family_keeps_the_env_contract_at_coarse() {
         "cube",
         "naca0012",
         "cavity",
+        "stenotic_pipe",
     ] {
         assert!(specs.iter().any(|s| s.family == family), "no 3D {family} ID registered");
     }
@@ -351,4 +352,33 @@ fn multi_agent_td3_trains_on_the_segmented_cylinder_through_the_cli() {
         "--json",
     ]);
     assert!(text.contains("drag_reduction_pct"), "{text}");
+}
+
+/// The 3D stenotic pipe carries a temperature: `(u, v, w, p, T)` at each probe, the action moves
+/// the inlet temperature by at most its bound per action within its range, the reward is the
+/// target probe's temperature error, and the field stays between the coldest inlet and the wall
+/// temperature.
+#[test]
+fn the_3d_pipe_observes_and_sets_the_temperature() {
+    let spec = specs3()
+        .into_iter()
+        .find(|s| s.id == "StenoticPipe_3D_Re100")
+        .expect("the 3D pipe is registered");
+    let spec = short(&spec, 4);
+    let mut env = LbmEnv3::new(spec.clone(), Level::Coarse, None).unwrap();
+    assert_eq!(spec.obs_dim(), 5 * 10);
+    let (obs, _) = env.reset(1).unwrap();
+    let temperatures: Vec<f64> = obs.chunks(5).map(|p| p[4]).collect();
+    assert!(temperatures.iter().all(|t| (0.85..=1.0 + 1e-6).contains(t)), "{temperatures:?}");
+    let mut inlet = 0.9;
+    for a in [1.0, 1.0, -1.0, 0.5] {
+        let r = env.step(&[a]).unwrap();
+        assert!(!r.terminated, "{:?}", r.info.text("reason"));
+        let set = r.info.get("actuation_0").unwrap();
+        assert!((set - (inlet + 0.05 * a)).abs() < 1e-12, "inlet {inlet} + 0.05 x {a} gave {set}");
+        inlet = set;
+        let t = r.info.get("T_target").unwrap();
+        assert!((r.reward + 100.0 * (t - 0.95).abs()).abs() < 1e-9, "reward {} at T {t}", r.reward);
+        assert!(r.obs.chunks(5).all(|p| (0.85..=1.0 + 1e-6).contains(&p[4])), "{:?}", r.obs);
+    }
 }

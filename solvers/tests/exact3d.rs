@@ -269,6 +269,71 @@ fn uniform_stream_passes_inlet_outlet_and_free_slip_faces_unchanged() {
     assert!(worst < 1e-6, "{worst:.2e}");
 }
 
+/// A velocity face with a parabolic profile between two walls feeds plane Poiseuille flow: the
+/// sections downstream of the inlet's corners carry the profile's shape (the pressure drop that drives the flow
+/// compresses the fluid a little, so each section is compared with its own peak) and the
+/// inflow's mass flux; a face that is not a velocity face refuses a profile.
+#[test]
+fn a_face_profile_feeds_its_shape_into_the_channel() {
+    let (nx, ny) = (48, 12);
+    let u_max = 0.04;
+    let mut cfg = D3Config::new([nx, ny, 3], 0.8);
+    cfg.faces = Faces([
+        Face::Velocity([u_max as f32, 0.0, 0.0]),
+        Face::Outlet,
+        Face::Wall,
+        Face::Wall,
+        Face::Periodic,
+        Face::Periodic,
+    ]);
+    let mut s = Lbm3::<19, D3q19>::new(cfg, &[]).unwrap();
+    // Walls half-way outside the first and last nodes: y in (-1/2, ny - 1/2).
+    let shape = |y: f64| {
+        let eta = (y + 0.5) / ny as f64;
+        4.0 * eta * (1.0 - eta)
+    };
+    s.set_face_profile(0, |p| shape(p[1])).unwrap();
+    assert!(s
+        .set_face_profile(1, |_| 1.0)
+        .unwrap_err()
+        .to_string()
+        .contains("not a velocity face"));
+    s.set_equilibrium(|_, y, _| (1.0, [u_max * shape(y as f64), 0.0, 0.0]));
+    for _ in 0..8000 {
+        s.step().unwrap();
+    }
+    let peak = (0..ny).map(|y| shape(y as f64)).fold(0.0, f64::max);
+    let flux_at = |x: usize| -> f64 {
+        (0..ny)
+            .map(|y| {
+                let (rho, u) = s.rho_u([x, y, 1]);
+                rho * u[0]
+            })
+            .sum()
+    };
+    let inflow = flux_at(0);
+    let (mut worst_shape, mut worst_flux) = (0.0f64, 0.0f64);
+    // Sections past the few nodes where the inlet meets the walls.
+    for x in [nx / 2, nx - 4] {
+        let section: Vec<(f64, f64)> = (0..ny)
+            .map(|y| {
+                let (rho, u) = s.rho_u([x, y, 1]);
+                (rho, u[0])
+            })
+            .collect();
+        let top = section.iter().map(|v| v.1).fold(0.0, f64::max);
+        for (y, (_, u)) in section.iter().enumerate() {
+            worst_shape = worst_shape.max((u / top - shape(y as f64) / peak).abs());
+        }
+        worst_flux = worst_flux.max((flux_at(x) / inflow - 1.0).abs());
+    }
+    println!("parabolic inflow through a {nx}-node channel: shape within {worst_shape:.2e} of the peak, mass flux within {worst_flux:.2e}");
+    assert!(
+        worst_shape < 2e-3 && worst_flux < 1e-5,
+        "shape {worst_shape:.3e}, flux {worst_flux:.3e}"
+    );
+}
+
 fn oracle_case<const Q: usize, L: Lattice3<Q>>(collision: Collision, smagorinsky: f64) -> Lbm3<Q, L> {
     let mut cfg = D3Config::new([13, 11, 9], 0.52);
     cfg.collision = collision;
@@ -317,6 +382,7 @@ fn oracle_case_with_faces<const Q: usize, L: Lattice3<Q>>(collision: Collision, 
     let mut s = Lbm3::<Q, L>::new(cfg, &[&sphere]).unwrap();
     s.set_wall_velocity(0, |p| [0.0, -0.01 * (p[2] - 4.4), 0.01 * (p[1] - 5.1)]);
     s.set_velocity_scale(0.7);
+    s.set_face_profile(0, |p| 1.0 - 0.01 * (p[1] - 5.0).powi(2) + 0.02 * p[2]).unwrap();
     s.set_equilibrium(|x, y, z| {
         (
             1.0 + 0.001 * ((x + 2 * y) % 5) as f64,

@@ -25,7 +25,7 @@ use hgym_solvers::lbm::{D2q9, Edge, LbmError, Side, Units};
 
 use super::actuation::{apply, Jet};
 use super::family::{merged, CalibrateError, FamilySpec, FlowEnv, Spec};
-use super::seeding::splitmix64;
+use super::seeding::{gaussian, splitmix64};
 use super::spec::{ActuationSpec, EnvSpec, RewardSpec};
 use super::EnvInputError;
 use crate::flow::{FlowError, LbmFlow, Level};
@@ -49,16 +49,6 @@ pub struct LbmEnv {
     fields: [Vec<f32>; 3],
     /// Seed of the inflow noise (0 during the spin-up, the episode's seed after a reset).
     noise_seed: u64,
-}
-
-/// A standard normal number for interval `k` of a run seeded `seed` (Box-Muller on two
-/// splitmix64 draws): stateless, so any interval's value is known without replaying the others.
-fn gaussian(seed: u64, k: u64) -> f64 {
-    let a = splitmix64(seed ^ splitmix64(k));
-    let b = splitmix64(a);
-    let u1 = ((a >> 11) as f64 + 0.5) / (1u64 << 53) as f64;
-    let u2 = (b >> 11) as f64 / (1u64 << 53) as f64;
-    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
 
 fn backend(e: impl std::fmt::Display) -> EnvError {

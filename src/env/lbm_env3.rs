@@ -12,20 +12,27 @@
 //!
 //! Agents: a section actuator on more than one segment makes one agent per segment
 //! (`hgym_agents::multi`), each seeing its segment's probes and setting its segment's actuators.
+//!
+//! A spec with `thermal` also carries a temperature field (D3Q7, stepped after every flow step
+//! with the flow's velocity; one process only), observed at the probes and set at the inlet by an
+//! inlet-temperature actuator; with `inflow` the inlet's scale oscillates, as in 2D
+//! (`lbm_env.rs`).
 
 use std::path::{Path, PathBuf};
 
 use hgym_agents::multi::Agents;
 use hgym_agents::{checked_action, BoxSpace, Env, EnvError, Info, StepResult};
+use hgym_solvers::lbm::d3::Thermal3;
+use hgym_solvers::lbm::thermal::ThermalSide;
 use hgym_solvers::lbm::{LbmError, Units};
 
 use super::actuation::{section_velocity, Jet};
 use super::family::{merged, CalibrateError, FamilySpec, FlowEnv, Spec};
-use super::seeding::splitmix64;
-use super::spec::RewardSpec;
+use super::seeding::{gaussian, splitmix64};
+use super::spec::{ActuationSpec, RewardSpec};
 use super::spec3::{Actuation3Spec, Env3Spec};
 use super::EnvInputError;
-use crate::flow::{FlowError, LbmFlow3, Level};
+use crate::flow::{BoundaryKind, FlowError, LbmFlow3, Level};
 
 pub struct LbmEnv3 {
     spec: Env3Spec,
@@ -47,6 +54,11 @@ pub struct LbmEnv3 {
     cache_dir: Option<PathBuf>,
     t0: u64,
     segment_rewards: Vec<f64>,
+    /// The temperature field (specs with `thermal`) and the flow velocity it is carried by.
+    thermal: Option<Thermal3>,
+    velocity: [Vec<f32>; 3],
+    /// Seed of the inflow noise (0 during the spin-up, the episode's seed after a reset).
+    noise_seed: u64,
 }
 
 fn backend(e: impl std::fmt::Display) -> EnvError {
@@ -59,11 +71,12 @@ struct Coefficients {
     segment: Vec<[f64; 3]>,
 }
 
-/// The reward of an interval from its forces and the (normalised) observation at its end:
-/// `-sum |C_D| - w sum |(C_L, C_S)|` over `forces` (each body's own, `drag_lift`), or of their sum
-/// (`total_drag_lift`); `-|C_L - C_L,ref| - w |C_D - C_D,ref|` of their sum (`gust_loads`);
-/// `-9 sum obs^2` (`probe_deviation`); as in 2D.
-fn reward(spec: &RewardSpec, forces: &[[f64; 3]], obs: &[f64]) -> f64 {
+/// The reward of an interval from its forces, the (normalised) observation at its end and the
+/// temperature at the reward's probe: `-sum |C_D| - w sum |(C_L, C_S)|` over `forces` (each
+/// body's own, `drag_lift`), or of their sum (`total_drag_lift`); `-|C_L - C_L,ref| - w |C_D -
+/// C_D,ref|` of their sum (`gust_loads`); `-9 sum obs^2` (`probe_deviation`); `-w |T - T_target|`
+/// (`probe_temperature`); as in 2D.
+fn reward(spec: &RewardSpec, forces: &[[f64; 3]], obs: &[f64], probe_temperature: Option<f64>) -> f64 {
     let lateral = |f: &[f64; 3]| f[1].hypot(f[2]);
     match spec {
         RewardSpec::DragLift { lift_weight } => forces.iter().map(|f| -f[0].abs() - lift_weight * lateral(f)).sum(),
@@ -80,9 +93,49 @@ fn reward(spec: &RewardSpec, forces: &[[f64; 3]], obs: &[f64]) -> f64 {
             let (c_d, c_l) = forces.iter().fold((0.0, 0.0), |(d, l), f| (d + f[0], l + f[1]));
             -(c_l - c_l_ref).abs() - drag_weight * (c_d - c_d_ref).abs()
         }
-        // `Env3Spec::check` admits only the rewards above.
-        _ => f64::NAN,
+        RewardSpec::ProbeTemperature { target, weight, .. } => -weight * (probe_temperature.unwrap_or(f64::NAN) - target).abs(),
     }
+}
+
+/// The temperature field of `spec` on the solver's grid: the flow's solid nodes at the wall
+/// temperature, the inlet at the inlet temperature, open outlets at zero gradient, periodic
+/// faces periodic, every other face at the wall temperature; `kappa = nu / Pr`. One process.
+fn thermal_field(spec: &Env3Spec, solver: &LbmFlow3, units: &Units) -> Result<Option<Thermal3>, EnvError> {
+    let Some(th) = &spec.thermal else {
+        return Ok(None);
+    };
+    if solver.rank().1 > 1 {
+        return Err(EnvError::InvalidSpec(format!(
+            "{}: its temperature field runs on one process (it is not split over ranks); run it without mpirun",
+            spec.id
+        )));
+    }
+    let side = |k: BoundaryKind, inlet: bool| match k {
+        BoundaryKind::Periodic => ThermalSide::Periodic,
+        BoundaryKind::Outlet => ThermalSide::ZeroGradient,
+        BoundaryKind::Inlet if inlet => ThermalSide::Temperature(th.inlet_temperature as f32),
+        _ => ThermalSide::Temperature(th.wall_temperature as f32),
+    };
+    let b = &spec.boundaries;
+    let z = spec.span.boundary;
+    let faces = [
+        side(b.west, true),
+        side(b.east, false),
+        side(b.south, false),
+        side(b.north, false),
+        side(z, false),
+        side(z, false),
+    ];
+    let n = solver.n();
+    let solid = (0..n[2])
+        .flat_map(|z| (0..n[1]).flat_map(move |y| (0..n[0]).map(move |x| [x, y, z])))
+        .map(|p| solver.is_solid(p))
+        .collect();
+    // D3Q7: kappa = (tau - 1/2) / 4.
+    let tau = 0.5 + 4.0 * units.nu() / th.prandtl;
+    let mut field = Thermal3::new(n, tau, faces, solid, th.wall_temperature).map_err(backend)?;
+    field.init_with(|_| th.initial_temperature);
+    Ok(Some(field))
 }
 
 impl LbmEnv3 {
@@ -109,7 +162,12 @@ impl LbmEnv3 {
         let segment_scale = force_scale / spec.segments() as f64;
         let steps_per_action = units.steps(spec.control_interval).max(1);
         let act_dim = spec.act_dim();
+        let thermal = thermal_field(&spec, &solver, &units)?;
+        let cells = if thermal.is_some() { solver.n().iter().product() } else { 0 };
         Ok(LbmEnv3 {
+            thermal,
+            velocity: std::array::from_fn(|_| vec![0.0; cells]),
+            noise_seed: 0,
             probes: spec.probe_points(),
             segment_rewards: vec![0.0; spec.segments()],
             spec,
@@ -146,11 +204,25 @@ impl LbmEnv3 {
         self.steps_per_action
     }
 
-    /// Sets every body's wall velocity for physical actuation `a` (units of U or U/D).
+    /// The temperature field, for specs with a `[thermal]` section.
+    pub fn thermal(&self) -> Option<&Thermal3> {
+        self.thermal.as_ref()
+    }
+
+    /// Sets every body's wall velocity for physical actuation `a` (units of U or U/D), or the
+    /// inlet's temperature (units of T_wall).
     fn actuate(&mut self, a: &[f64]) {
         let units = self.units;
         let lattice = |u: [f64; 3]| u.map(|v| units.lattice_velocity(v));
         match &self.spec.actuation {
+            Actuation3Spec::Segments {
+                actuator: ActuationSpec::InletTemperature { .. },
+            } => {
+                if let Some(th) = &mut self.thermal {
+                    // Finite and within the spec's range by construction (see `step`).
+                    let _ = th.set_face_temperature(0, a[0]);
+                }
+            }
             Actuation3Spec::Segments { actuator } => {
                 let k = actuator.dim();
                 let (z0, lz, segments) = (self.spec.span.z[0], self.spec.span.length(), self.spec.segments());
@@ -181,6 +253,47 @@ impl LbmEnv3 {
                 }
             }
         }
+    }
+
+    /// The actuation with the actuators at rest: zero, or the starting inlet temperature.
+    fn rest_actuation(&self) -> Vec<f64> {
+        match (&self.spec.actuation, &self.spec.thermal) {
+            (
+                Actuation3Spec::Segments {
+                    actuator: ActuationSpec::InletTemperature { .. },
+                },
+                Some(th),
+            ) => vec![th.inlet_temperature],
+            _ => vec![0.0; self.spec.act_dim()],
+        }
+    }
+
+    /// One lattice step of everything the spec has: the oscillatory inflow's scale, the flow,
+    /// and the temperature carried by it. Without those, exactly the flow's step.
+    fn substep(&mut self) -> Result<(), LbmError> {
+        if let Some(inflow) = &self.spec.inflow {
+            let t = self.solver.time() as f64 * self.units.time_per_step();
+            let k = (t / self.spec.control_interval).floor().max(0.0) as u64;
+            let omega = inflow.omega(self.spec.reynolds);
+            let scale = (omega * t).sin() + inflow.noise * gaussian(self.noise_seed, k);
+            self.solver.set_boundary_velocity_scale(scale);
+        }
+        self.solver.step()?;
+        if let Some(th) = &mut self.thermal {
+            let [ux, uy, uz] = &mut self.velocity;
+            self.solver.velocity_field([ux, uy, uz])?;
+            th.step([ux, uy, uz])?;
+        }
+        Ok(())
+    }
+
+    /// The state a developed-flow cache keeps: the populations, then the temperature's.
+    fn state(&self) -> Vec<f32> {
+        let mut state = self.solver.populations().to_vec();
+        if let Some(th) = &self.thermal {
+            state.extend_from_slice(th.populations());
+        }
+        state
     }
 
     /// Mass (lattice units per step) each action alone injects at `action` (in [-1, 1], a
@@ -236,7 +349,7 @@ impl LbmEnv3 {
         if self.attractor.is_some() {
             return Ok(());
         }
-        let want = self.solver.populations().len();
+        let want = self.solver.populations().len() + self.thermal.as_ref().map_or(0, |t| t.populations().len());
         let cached = self.cache_file().and_then(|p| super::spin_up::load_state(&p, want));
         // Under MPI the ranks spin up together unless every one of them has its slab cached.
         if self.solver.all_ranks(cached.is_some()) {
@@ -258,13 +371,14 @@ impl LbmEnv3 {
             let along = 1.0 + 0.5 * (2.0 * std::f64::consts::PI * (p[2] - z0) / lz).sin();
             (1.0, [u, 0.3 * u * along * (-4.0 * r2).exp(), 0.0])
         });
-        let rest = vec![0.0; self.spec.act_dim()];
+        let rest = self.rest_actuation();
         self.actuate(&rest);
+        self.noise_seed = 0;
         let steps = self.units.steps(self.spec.spin_up);
         let id = self.spec.id.clone();
-        super::spin_up::run_reported(&id, steps, |n| (0..n).try_for_each(|_| self.solver.step()))
+        super::spin_up::run_reported(&id, steps, |n| (0..n).try_for_each(|_| self.substep()))
             .map_err(|e| EnvError::Backend(format!("{}: spin-up diverged: {e}", self.spec.id)))?;
-        let state = self.solver.populations().to_vec();
+        let state = self.state();
         if let Some(path) = self.cache_file() {
             super::spin_up::store_state(&path, &state);
         }
@@ -272,14 +386,26 @@ impl LbmEnv3 {
         Ok(())
     }
 
-    /// Raw probe values, `(u, v, w, p)` per probe and segment (units of U and rho U^2).
+    /// Raw probe values, `(u, v, w, p)` and with a temperature field `T`, per probe and segment
+    /// (units of U, rho U^2 and T_wall).
     pub fn raw_observation(&self) -> Result<Vec<f64>, EnvError> {
         let mut obs = Vec::with_capacity(self.spec.obs_dim());
-        for (rho, u) in self.solver.probes(&self.probes).map_err(backend)? {
+        for ((rho, u), x) in self.solver.probes(&self.probes).map_err(backend)?.into_iter().zip(&self.probes) {
             obs.extend(u.map(|v| self.units.velocity(v)));
             obs.push(self.units.pressure(rho));
+            if let Some(t) = self.temperature_at(*x) {
+                obs.push(t);
+            }
         }
         Ok(obs)
+    }
+
+    /// Temperature (units of T_wall) at a physical point, trilinear.
+    fn temperature_at(&self, x: [f64; 3]) -> Option<f64> {
+        let th = self.thermal.as_ref()?;
+        let g = self.solver.grid();
+        let t_wall = self.spec.thermal.as_ref().map_or(1.0, |s| s.wall_temperature);
+        Some(th.sample([0, 1, 2].map(|a| (x[a] - g.origin[a]) / g.dx)) / t_wall)
     }
 
     fn observation(&self) -> Result<Vec<f64>, EnvError> {
@@ -320,7 +446,7 @@ impl LbmEnv3 {
             }
             self.actuate(&now);
             self.set_gust(self.time())?;
-            self.solver.step()?;
+            self.substep()?;
             for (acc, f) in c.body.iter_mut().zip(self.solver.body_forces()) {
                 (0..3).for_each(|a| acc[a] += f[a] / self.force_scale / n as f64);
             }
@@ -352,14 +478,27 @@ impl Env for LbmEnv3 {
     fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
         self.develop()?;
         let state = self.attractor.as_deref().unwrap_or_default();
-        self.solver.set_populations(state, 0).map_err(backend)?;
-        self.a_old = vec![0.0; self.spec.act_dim()];
+        let n_flow = self.solver.populations().len();
+        // An oscillating inflow continues its phase from the end of the spin-up.
+        let time = if self.spec.inflow.is_some() {
+            self.units.steps(self.spec.spin_up)
+        } else {
+            0
+        };
+        self.solver
+            .set_populations(&state[..n_flow.min(state.len())], time)
+            .map_err(backend)?;
+        if let Some(th) = &mut self.thermal {
+            th.set_populations(&state[n_flow.min(state.len())..]).map_err(backend)?;
+        }
+        self.noise_seed = seed;
+        self.a_old = self.rest_actuation();
         let rest = self.a_old.clone();
         self.actuate(&rest);
         self.set_gust(0.0).map_err(backend)?;
         let offset = (splitmix64(seed) % 64) * (self.steps_per_action / 2).max(1);
         for _ in 0..offset {
-            self.solver.step().map_err(backend)?;
+            self.substep().map_err(backend)?;
         }
         self.t0 = self.solver.time();
         self.actions_taken = 0;
@@ -376,7 +515,13 @@ impl Env for LbmEnv3 {
         }
         let (a, clipped) = checked_action(&self.action_space(), action)?;
         let bound = self.spec.actuation.bound();
-        let a_new: Vec<f64> = a.iter().map(|v| v * bound).collect();
+        let a_new: Vec<f64> = match &self.spec.actuation {
+            // The action is a change of the inlet temperature.
+            Actuation3Spec::Segments {
+                actuator: ActuationSpec::InletTemperature { range, .. },
+            } => vec![(self.a_old[0] + a[0] * bound).clamp(range[0], range[1])],
+            _ => a.iter().map(|v| v * bound).collect(),
+        };
         let result = self.interval(&a_new);
         self.a_old = a_new.clone();
         self.actions_taken += 1;
@@ -403,6 +548,14 @@ impl Env for LbmEnv3 {
         };
         let segments = self.spec.segments();
         let obs = self.observation()?;
+        let probe_temperature = match &self.spec.reward {
+            RewardSpec::ProbeTemperature { probe, .. } => {
+                let t = self.probes.get(*probe).and_then(|p| self.temperature_at(*p));
+                info.set("T_target", t.unwrap_or(f64::NAN));
+                t
+            }
+            _ => None,
+        };
         let per_segment = obs.len() / segments;
         let mut total = [0.0; 3];
         for (b, f) in c.body.iter().enumerate() {
@@ -418,9 +571,14 @@ impl Env for LbmEnv3 {
             let of_segment: Vec<[f64; 3]> = (0..c.body.len()).map(|b| c.segment[b * segments + s]).collect();
             info.set(&format!("C_D_seg{s}"), of_segment.iter().map(|f| f[0]).sum());
             info.set(&format!("C_L_seg{s}"), of_segment.iter().map(|f| f[1]).sum());
-            self.segment_rewards[s] = reward(&self.spec.reward, &of_segment, &obs[s * per_segment..(s + 1) * per_segment]);
+            self.segment_rewards[s] = reward(
+                &self.spec.reward,
+                &of_segment,
+                &obs[s * per_segment..(s + 1) * per_segment],
+                probe_temperature,
+            );
         }
-        let reward = reward(&self.spec.reward, &c.body, &obs);
+        let reward = reward(&self.spec.reward, &c.body, &obs, probe_temperature);
         let truncated = self.actions_taken >= self.spec.episode_actions;
         if truncated {
             self.live = false;
@@ -524,9 +682,11 @@ impl FamilySpec for Env3Spec {
     }
 
     fn solver(&self) -> &'static str {
-        match self.span.lattice {
-            crate::flow::span::Lattice3Name::D3q19 => "lbm-d3q19",
-            crate::flow::span::Lattice3Name::D3q27 => "lbm-d3q27",
+        match (self.span.lattice, self.thermal.is_some()) {
+            (crate::flow::span::Lattice3Name::D3q19, false) => "lbm-d3q19",
+            (crate::flow::span::Lattice3Name::D3q19, true) => "lbm-d3q19+q7",
+            (crate::flow::span::Lattice3Name::D3q27, false) => "lbm-d3q27",
+            (crate::flow::span::Lattice3Name::D3q27, true) => "lbm-d3q27+q7",
         }
     }
 

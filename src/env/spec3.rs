@@ -4,7 +4,8 @@
 //!
 //! Layout of the vectors (what multi-agent training splits, one agent per segment):
 //! - observation: for segment `s`, probe `p`: `(u, v, w, p)` at `4 (s P + p)`, units of U and
-//!   rho U^2, at `(x_p, y_p, z_s)` with `z_s` the segment's mid-plane;
+//!   rho U^2, at `(x_p, y_p, z_s)` with `z_s` the segment's mid-plane; with a temperature field
+//!   `(u, v, w, p, T)` at `5 (s P + p)`, T in units of the wall temperature;
 //! - action: a section actuator (`segments`) acts on each segment separately, its `k`-th action of
 //!   segment `s` at `s K + k`; surface jets (`surface_jets`) have one action each.
 
@@ -15,8 +16,8 @@ use hgym_agents::multi::AgentReward;
 use hgym_solvers::lbm::Collision;
 
 use super::actuation::Ramp;
-use super::spec::{ActuationSpec, GustSpec, Normalization, RewardSpec, SpongeSpec};
-use crate::flow::{BoundarySpec, DomainSpec, FlowSetup, GeometrySpec, InletSpec, ResolutionSpec, SpanSpec};
+use super::spec::{ActuationSpec, GustSpec, InflowSpec, Normalization, RewardSpec, SpongeSpec, ThermalSpec};
+use crate::flow::{BoundarySpec, DomainSpec, FlowSetup, GeometrySpec, InletSpec, Profile, ResolutionSpec, SpanSpec, VelocityReference};
 
 /// The actuators of a 3D environment; actions in `[-1, 1]` are scaled by the bound given here.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -184,6 +185,13 @@ pub struct Env3Spec {
     /// A transverse gust entering through the inlet during each episode (as in 2D).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gust: Option<GustSpec>,
+    /// A passive temperature field (D3Q7, `hgym_solvers::lbm::d3::Thermal3`), as in 2D: walls
+    /// at `wall_temperature`, the inlet at the inlet temperature, zero gradient at an outlet.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thermal: Option<Box<ThermalSpec>>,
+    /// Oscillatory inflow (a pipe's Poiseuille profile whose scale oscillates), as in 2D.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inflow: Option<Box<InflowSpec>>,
 }
 
 impl Env3Spec {
@@ -197,9 +205,14 @@ impl Env3Spec {
         self.span.segments
     }
 
-    /// `(u, v, w, p)` per probe and segment.
+    /// `(u, v, w, p)`, and `T` with a temperature field, per probe and segment.
     pub fn obs_dim(&self) -> usize {
-        4 * self.probes.len() * self.segments()
+        self.per_probe() * self.probes.len() * self.segments()
+    }
+
+    /// Values observed at each probe: `(u, v, w, p)`, and `T` with a temperature field.
+    pub fn per_probe(&self) -> usize {
+        4 + usize::from(self.thermal.is_some())
     }
 
     pub fn act_dim(&self) -> usize {
@@ -220,13 +233,22 @@ impl Env3Spec {
         matches!(self.family.as_str(), "sphere" | "cube").then(|| format!("{}_re{}", self.family, self.reynolds.round() as i64))
     }
 
-    /// The flow this environment runs: a uniform rigid inlet and the span.
+    /// The flow this environment runs: a uniform rigid inlet (with `inflow`, a pipe's
+    /// Poiseuille profile of mean U whose scale oscillates) and the span.
     pub fn flow_setup(&self) -> FlowSetup {
+        let inlet = match &self.inflow {
+            None => InletSpec::default(),
+            Some(_) => InletSpec {
+                profile: Profile::Parabolic,
+                reference_velocity: VelocityReference::Mean,
+                ..InletSpec::default()
+            },
+        };
         FlowSetup {
             bodies: self.bodies.clone(),
             domain: self.domain.clone(),
             boundaries: self.boundaries.clone(),
-            inlet: InletSpec::default(),
+            inlet,
             reynolds: self.reynolds,
             lattice_velocity: self.lattice_velocity,
             collision: self.collision,
@@ -247,10 +269,19 @@ impl Env3Spec {
         super::spec::check_probes(&self.probes)?;
         match &self.actuation {
             Actuation3Spec::Segments { actuator } => {
-                if matches!(actuator, ActuationSpec::InletTemperature { .. }) {
-                    return Err("actuation: 3D flows carry no temperature; use jets or rotation".into());
+                if let ActuationSpec::InletTemperature { range, .. } = actuator {
+                    if self.thermal.is_none() {
+                        return Err("actuation: an inlet-temperature actuator needs a [thermal] section".into());
+                    }
+                    if self.segments() != 1 {
+                        return Err("actuation: the inlet temperature is one actuator; use one segment (span.segments = 1)".into());
+                    }
+                    if !(range[0].is_finite() && range[1].is_finite() && range[0] < range[1]) {
+                        return Err(format!("actuation: range must be [low, high] with low < high, got {range:?}"));
+                    }
+                } else {
+                    super::actuation::resolve(actuator, &self.bodies).map_err(|m| format!("actuation: {m}"))?;
                 }
-                super::actuation::resolve(actuator, &self.bodies).map_err(|m| format!("actuation: {m}"))?;
             }
             Actuation3Spec::SurfaceJets { body, jets, .. } => {
                 if *body >= self.bodies.len() {
@@ -268,13 +299,32 @@ impl Env3Spec {
         if !(b.is_finite() && b > 0.0) {
             return Err(format!("actuation: the bound must be a positive number, got {b}"));
         }
-        if !matches!(
-            self.reward,
-            RewardSpec::DragLift { .. } | RewardSpec::TotalDragLift { .. } | RewardSpec::ProbeDeviation | RewardSpec::GustLoads { .. }
-        ) {
-            return Err(
-                "reward: 3D flows reward forces or probe deviations: use drag_lift, total_drag_lift, gust_loads or probe_deviation".into(),
-            );
+        match &self.reward {
+            RewardSpec::DragLift { .. } | RewardSpec::TotalDragLift { .. } | RewardSpec::ProbeDeviation | RewardSpec::GustLoads { .. } => {}
+            RewardSpec::ProbeTemperature { probe, .. } => {
+                if self.thermal.is_none() {
+                    return Err("reward: probe_temperature needs a [thermal] section".into());
+                }
+                if *probe >= self.probes.len() {
+                    return Err(format!("reward: probe {probe} does not exist ({} probes)", self.probes.len()));
+                }
+            }
+        }
+        if let Some(th) = &self.thermal {
+            let values = [th.prandtl, th.wall_temperature, th.inlet_temperature, th.initial_temperature];
+            if !(values.iter().all(|v| v.is_finite()) && th.prandtl > 0.0) {
+                return Err(format!("thermal: needs a positive prandtl and finite temperatures, got {th:?}"));
+            }
+        }
+        if let Some(inflow) = &self.inflow {
+            if self.boundaries.west != crate::flow::BoundaryKind::Inlet {
+                return Err("inflow: an oscillatory inflow enters through the inlet; make the west boundary an inlet".into());
+            }
+            if !(inflow.womersley.is_finite() && inflow.womersley > 0.0 && inflow.noise.is_finite() && inflow.noise >= 0.0) {
+                return Err(format!(
+                    "inflow: needs a positive womersley number and a noise >= 0, got {inflow:?}"
+                ));
+            }
         }
         if self.gust.is_some() && self.boundaries.west != crate::flow::BoundaryKind::Inlet {
             return Err("gust: a gust enters through the inlet; make the west boundary an inlet".into());
@@ -328,6 +378,8 @@ pub fn extrude(
         normalization: Normalization::default(),
         sponge: base.sponge,
         gust: base.gust,
+        thermal: base.thermal,
+        inflow: base.inflow,
     }
 }
 

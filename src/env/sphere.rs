@@ -99,6 +99,8 @@ pub(super) fn in_box(
         normalization: Normalization::default(),
         sponge: None,
         gust: None,
+        thermal: None,
+        inflow: None,
     }
 }
 

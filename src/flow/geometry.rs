@@ -59,6 +59,15 @@ pub enum GeometrySpec {
         length: f64,
         severity: f64,
     },
+    /// A round pipe along x (3D flows only) whose radius narrows by the same cosine law to a
+    /// throat at `center` (on the pipe's axis); solid outside it. Reference length: the diameter.
+    Pipe {
+        #[serde(deserialize_with = "super::triple")]
+        center: [f64; 3],
+        diameter: f64,
+        length: f64,
+        severity: f64,
+    },
 }
 
 impl GeometrySpec {
@@ -135,12 +144,19 @@ impl GeometrySpec {
                 finite("center", center)?;
                 positive("width", *width)?;
                 positive("length", *length)?;
-                if !(severity.is_finite() && (0.0..0.5).contains(severity)) {
-                    return Err(format!(
-                        "severity must be in [0, 0.5) (0.25 halves the width at the throat; 0.5 closes it), got {severity}"
-                    ));
-                }
-                Ok(())
+                check_severity(*severity)
+            }
+            GeometrySpec::Pipe {
+                center,
+                diameter,
+                length,
+                severity,
+            } => {
+                finite("center", &[center[0], center[1]])?;
+                finite("center", &[center[2], 0.0])?;
+                positive("diameter", *diameter)?;
+                positive("length", *length)?;
+                check_severity(*severity)
             }
         }
     }
@@ -153,6 +169,7 @@ impl GeometrySpec {
             GeometrySpec::Naca { .. } => "naca",
             GeometrySpec::Cavity { .. } => "cavity",
             GeometrySpec::Stenosis { .. } => "stenosis",
+            GeometrySpec::Pipe { .. } => "pipe",
             GeometrySpec::Sphere { .. } => "sphere",
             GeometrySpec::Cube { .. } => "cube",
         }
@@ -165,6 +182,7 @@ impl GeometrySpec {
             GeometrySpec::Naca { chord, .. } => *chord,
             GeometrySpec::Cavity { depth, .. } => *depth,
             GeometrySpec::Stenosis { width, .. } => *width,
+            GeometrySpec::Pipe { diameter, .. } => *diameter,
             GeometrySpec::Sphere { diameter, .. } => *diameter,
             GeometrySpec::Cube { side, .. } => *side,
         }
@@ -177,7 +195,7 @@ impl GeometrySpec {
     pub fn starts_at_rest(&self, p: [f64; 2]) -> bool {
         match self {
             GeometrySpec::Cavity { leading_edge, .. } => p[1] < leading_edge[1],
-            GeometrySpec::Stenosis { .. } => true,
+            GeometrySpec::Stenosis { .. } | GeometrySpec::Pipe { .. } => true,
             _ => false,
         }
     }
@@ -186,7 +204,9 @@ impl GeometrySpec {
     pub fn center(&self) -> [f64; 2] {
         match self {
             GeometrySpec::Circle { center, .. } | GeometrySpec::Square { center, .. } | GeometrySpec::Stenosis { center, .. } => *center,
-            GeometrySpec::Sphere { center, .. } | GeometrySpec::Cube { center, .. } => [center[0], center[1]],
+            GeometrySpec::Sphere { center, .. } | GeometrySpec::Cube { center, .. } | GeometrySpec::Pipe { center, .. } => {
+                [center[0], center[1]]
+            }
             GeometrySpec::Naca { chord, leading_edge, .. } => [leading_edge[0] + 0.5 * chord, leading_edge[1]],
             GeometrySpec::Cavity {
                 leading_edge,
@@ -209,10 +229,26 @@ impl GeometrySpec {
         )
     }
 
-    /// Whether the body only exists in 3D (a sphere, a cube): the others are 2D sections,
+    /// Whether the body only exists in 3D (a sphere, a cube, a pipe): the others are 2D sections,
     /// extruded along the span in a 3D flow.
     pub fn is_3d_only(&self) -> bool {
-        matches!(self, GeometrySpec::Sphere { .. } | GeometrySpec::Cube { .. })
+        matches!(
+            self,
+            GeometrySpec::Sphere { .. } | GeometrySpec::Cube { .. } | GeometrySpec::Pipe { .. }
+        )
+    }
+
+    /// The laminar inflow of a duct body over its mean velocity at `p` (3D): Poiseuille's
+    /// `2 (1 - (r / R)^2)` inside a pipe of radius `R` at the inlet, 0 outside it; `None` for the
+    /// other shapes.
+    pub fn duct_inflow(&self, p: [f64; 3]) -> Option<f64> {
+        match self {
+            GeometrySpec::Pipe { center, diameter, .. } => {
+                let r = (p[1] - center[1]).hypot(p[2] - center[2]) / (0.5 * diameter);
+                Some((2.0 * (1.0 - r * r)).max(0.0))
+            }
+            _ => None,
+        }
     }
 
     /// The body's extent along z `[z0, z1]` (3D-only bodies), `None` for a section extruded
@@ -277,6 +313,28 @@ impl GeometrySpec {
                 length: *length,
                 severity: *severity,
             }),
+            // The axial section (the pipe's profile in the plane z = center z).
+            GeometrySpec::Pipe {
+                center,
+                diameter,
+                length,
+                severity,
+            } => Arc::new(Stenosis {
+                center: [center[0], center[1]],
+                width: *diameter,
+                length: *length,
+                severity: *severity,
+            }),
         }
+    }
+}
+
+fn check_severity(severity: f64) -> Result<(), String> {
+    if severity.is_finite() && (0.0..0.5).contains(&severity) {
+        Ok(())
+    } else {
+        Err(format!(
+            "severity must be in [0, 0.5) (0.25 halves the width at the throat; 0.5 closes it), got {severity}"
+        ))
     }
 }

@@ -238,10 +238,14 @@ impl FlowSetup {
                 if self.refinement.is_some() {
                     return Err(bad("refinement", "3D flows run on one uniform grid; remove the refinement regions"));
                 }
-                if self.inlet.profile != Profile::Uniform || self.inlet.characteristic_time > 0.0 {
+                let duct = self.bodies.iter().any(|b| b.duct_inflow([0.0; 3]).is_some());
+                let shaped = self.inlet.profile == Profile::Parabolic && duct && self.inlet.reference_velocity == VelocityReference::Mean;
+                if (self.inlet.profile != Profile::Uniform && !shaped) || self.inlet.characteristic_time > 0.0 {
                     return Err(bad(
                         "inlet",
-                        "a 3D inlet is uniform and rigid: use profile = \"uniform\" and characteristic_time = 0",
+                        "a 3D inlet is rigid and uniform, or parabolic (Poiseuille of the mean velocity) into a pipe body: \
+                         use profile = \"uniform\" (or \"parabolic\" with a pipe and reference_velocity = \"mean\") and \
+                         characteristic_time = 0",
                     ));
                 }
                 let dz = l / r.coarse.min(r.default).min(r.fine) as f64;

@@ -7,11 +7,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use hgym_solvers::geometry::{Cuboid, Extruded, Solid, Sphere};
+use hgym_solvers::geometry::{Cuboid, Extruded, Solid, Sphere, StenosedPipe};
 use hgym_solvers::lbm::d3::{D3Config, D3q19, D3q27, Face, Faces, Grid3, Lattice3, Lbm3, Sponge3};
 use hgym_solvers::lbm::LbmError;
 
-use super::{BoundaryKind, EdgeName, FlowError, FlowPlan, FlowSetup, GeometrySpec};
+use super::{BoundaryKind, EdgeName, FlowError, FlowPlan, FlowSetup, GeometrySpec, Profile};
 
 /// The 3D velocity set of a flow.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
@@ -122,6 +122,17 @@ impl GeometrySpec {
                 center: *center,
                 size: [*side; 3],
             }),
+            GeometrySpec::Pipe {
+                center,
+                diameter,
+                length,
+                severity,
+            } => Box::new(StenosedPipe {
+                center: *center,
+                width: *diameter,
+                length: *length,
+                severity: *severity,
+            }),
             other => Box::new(Extruded(other.shape())),
         }
     }
@@ -156,6 +167,16 @@ impl LbmFlow3 {
     /// Force on each (body, segment), `[b * segments + s]`.
     pub fn segment_forces(&self) -> &[[f64; 3]] {
         each!(self, s => s.segment_forces())
+    }
+
+    /// Shapes velocity face `face` by `profile(x)` at each node (see `Lbm3::set_face_profile`).
+    pub fn set_face_profile(&mut self, face: usize, profile: impl Fn([f64; 3]) -> f64) -> Result<(), LbmError> {
+        each!(self, s => s.set_face_profile(face, profile))
+    }
+
+    /// The velocity of every node (see `Lbm3::velocity_field`).
+    pub fn velocity_field(&self, u: [&mut [f32]; 3]) -> Result<(), LbmError> {
+        each!(self, s => s.velocity_field(u))
     }
 
     /// Sets the velocity of a velocity face (`2 a` the low end of axis `a`), lattice units.
@@ -247,7 +268,7 @@ impl LbmFlow3 {
 
 impl FlowSetup {
     /// Builds the 3D solver at `plan` (a set-up with a span): faces from the boundaries and the
-    /// span, the inlet's uniform velocity, collision, subgrid viscosity, absorbing layers on the
+    /// span, the inlet's velocity (uniform, or a pipe's Poiseuille profile), collision, subgrid viscosity, absorbing layers on the
     /// x and y faces, the bodies as solids.
     /// The fluid starts at rest; callers set their initial state.
     pub fn build3(&self, plan: &FlowPlan) -> Result<LbmFlow3, FlowError> {
@@ -313,10 +334,20 @@ impl FlowSetup {
             Lattice3Name::D3q19 => Lbm3::<19, D3q19>::new_split(cfg, &bodies, super::ranks::comm()).map(|s| LbmFlow3::D3q19(Box::new(s))),
             Lattice3Name::D3q27 => Lbm3::<27, D3q27>::new_split(cfg, &bodies, super::ranks::comm()).map(|s| LbmFlow3::D3q27(Box::new(s))),
         };
-        built.map_err(|e| match e {
+        let mut built = built.map_err(|e| match e {
             LbmError::Config { field, message } => FlowError::Invalid { field, message },
             other => FlowError::Solver(other),
-        })
+        })?;
+        // A parabolic 3D inlet is the laminar inflow of the duct it feeds (`check` makes sure
+        // there is one).
+        if self.inlet.profile == Profile::Parabolic {
+            if let Some(duct) = self.bodies.iter().find(|b| b.duct_inflow([0.0; 3]).is_some()) {
+                built
+                    .set_face_profile(0, |p| duct.duct_inflow(p).unwrap_or(0.0))
+                    .map_err(FlowError::Solver)?;
+            }
+        }
+        Ok(built)
     }
 }
 

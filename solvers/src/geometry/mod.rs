@@ -22,7 +22,7 @@ pub use naca::Naca4;
 pub use plane::HalfPlane;
 pub use rectangle::Rectangle;
 pub use solid::{Cuboid, Extruded, Solid, Sphere};
-pub use stenosis::Stenosis;
+pub use stenosis::{StenosedPipe, Stenosis};
 
 /// A closed body described by a signed distance function (negative inside).
 pub trait Shape: Send + Sync + std::fmt::Debug {

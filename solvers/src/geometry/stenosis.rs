@@ -8,8 +8,10 @@
 //! with `s0 = severity`: `s0 = 0.25` halves the width at the throat `x0` (Varghese et al.: 75 %
 //! area reduction of a pipe). The body is the wall material between `|y - center_y| = h(x)` and
 //! the channel walls; the walls themselves are the domain's sides.
+//!
+//! [`StenosedPipe`] is the original 3D geometry: a round pipe along x whose radius is `h(x)`.
 
-use super::Shape;
+use super::{Shape, Solid};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Stenosis {
@@ -46,6 +48,41 @@ impl Shape for Stenosis {
     }
 }
 
+/// A round pipe of diameter `width` along x through `(center[1], center[2])`, its radius `h(x)`
+/// of the cosine stenosis (throat at `x = center[0]`); solid outside that radius.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StenosedPipe {
+    pub center: [f64; 3],
+    pub width: f64,
+    pub length: f64,
+    pub severity: f64,
+}
+
+impl StenosedPipe {
+    /// The axial section's profile: the radius is its half-width.
+    pub fn section(&self) -> Stenosis {
+        Stenosis {
+            center: [self.center[0], 0.0],
+            width: self.width,
+            length: self.length,
+            severity: self.severity,
+        }
+    }
+
+    /// Distance from the pipe's axis.
+    pub fn radius_of(&self, p: [f64; 3]) -> f64 {
+        (p[1] - self.center[1]).hypot(p[2] - self.center[2])
+    }
+}
+
+impl Solid for StenosedPipe {
+    /// Radial distance `h(x) - r` (not the Euclidean one; its sign and zero set are exact, which
+    /// is all the lattice uses).
+    fn sdf(&self, p: [f64; 3]) -> f64 {
+        self.section().half_width(p[0]) - self.radius_of(p)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -64,5 +101,21 @@ mod tests {
         assert!(s.sdf([0.0, 0.3]) < 0.0 && s.sdf([0.0, 0.2]) > 0.0 && s.sdf([0.0, -0.3]) < 0.0);
         // Smooth and symmetric.
         assert!((s.half_width(0.4) - s.half_width(-0.4)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_pipe_is_round_and_narrows_to_its_throat() {
+        let p = StenosedPipe {
+            center: [0.0, 0.5, 0.5],
+            width: 1.0,
+            length: 2.0,
+            severity: 0.25,
+        };
+        // Radius 1/4 at the throat in every direction, 1/2 away from it.
+        for (dy, dz) in [(0.24, 0.0), (0.0, -0.24), (0.17, 0.17)] {
+            assert!(p.sdf([0.0, 0.5 + dy, 0.5 + dz]) > 0.0);
+        }
+        assert!(p.sdf([0.0, 0.5 + 0.18, 0.5 + 0.18]) < 0.0);
+        assert!(p.sdf([3.0, 0.5 + 0.35, 0.5 + 0.35]) > 0.0 && p.sdf([3.0, 0.5 + 0.36, 0.5 + 0.36]) < 0.0);
     }
 }

@@ -124,6 +124,9 @@ pub(crate) struct Ctx<'a> {
     /// `(rho - 1, j)` of every node of the outer layer of each velocity and outlet face, from
     /// the step's source (empty for the other faces; see [`FaceMoments`]).
     pub face_moments: &'a FaceMoments,
+    /// Per velocity face, the factor on its velocity at each node of its layer (indexed as
+    /// [`FaceMoments::at`]); empty: uniform.
+    pub face_profiles: &'a [Vec<f32>; 6],
     /// Write the bulk with non-temporal stores (arrays larger than the caches).
     pub stream_stores: bool,
 }
@@ -158,6 +161,17 @@ impl Ctx<'_> {
             };
         }
         Some(out)
+    }
+
+    /// The factor of face `f`'s velocity at its node `p` (1 on a uniform face).
+    #[inline(always)]
+    pub fn face_profile(&self, f: usize, p: [usize; 3]) -> f32 {
+        let profile = &self.face_profiles[f];
+        if profile.is_empty() {
+            1.0
+        } else {
+            profile[FaceMoments::at(self.n, f, p)]
+        }
     }
 
     #[inline(always)]

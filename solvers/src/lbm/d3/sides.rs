@@ -15,9 +15,10 @@ pub enum Face {
     Wall,
     /// Free-slip (specular reflection): zero normal velocity, zero shear.
     FreeSlip,
-    /// Uniform velocity (lattice units) by half-way bounce-back with the moving-wall term
+    /// Velocity (lattice units) by half-way bounce-back with the moving-wall term
     /// `g_k = g*_{opp k} + 6 w_k rho c_k.u`: an inlet, scaled by the solver's velocity scale
-    /// (ramps, gusts).
+    /// (ramps, gusts) and, node by node, by the face's profile (uniform unless set with
+    /// `Lbm3::set_face_profile`: a pipe's Poiseuille inflow).
     Velocity([f32; 3]),
     /// Open boundary: zero gradient across the face, shifted to the equilibrium at `rho = 1`
     /// (non-equilibrium extrapolation, Guo, Zheng & Shi 2002), which anchors the pressure.
@@ -133,7 +134,7 @@ pub(crate) fn face_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p
     match &c.faces.0[f] {
         Face::Velocity(u) => {
             let g: [f32; Q] = std::array::from_fn(|i| src[c.idx::<Q>(p, i)]);
-            velocity_value::<Q, L>(c, k, g[opp], moments::<Q, L>(&g).0, u)
+            velocity_value::<Q, L>(c, k, g[opp], moments::<Q, L>(&g).0, u, c.face_profile(f, p))
         }
         Face::Outlet => {
             let b = outlet_node(c, p, ck);
@@ -156,7 +157,7 @@ pub(crate) fn face_value_planned<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &
     match &c.faces.0[f] {
         Face::Velocity(u) => {
             let drho = layer[FaceMoments::at(c.n, f, p)][0];
-            velocity_value::<Q, L>(c, k, src[c.idx::<Q>(p, L::OPP_REF[k])], drho, u)
+            velocity_value::<Q, L>(c, k, src[c.idx::<Q>(p, L::OPP_REF[k])], drho, u, c.face_profile(f, p))
         }
         Face::Outlet => {
             let b = outlet_node(c, p, ck);
@@ -168,13 +169,14 @@ pub(crate) fn face_value_planned<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &
 }
 
 /// Half-way bounce-back from a moving face: `g_opp + 6 w_k rho c_k.u` (the face velocity `u`
-/// times the solver's velocity scale), with the node's own `rho - 1`.
+/// times the solver's velocity scale and the face's profile at the node), with the node's own
+/// `rho - 1`.
 #[inline]
-fn velocity_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, k: usize, g_opp: f32, drho: f32, u: &[f32; 3]) -> f32 {
+fn velocity_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, k: usize, g_opp: f32, drho: f32, u: &[f32; 3], profile: f32) -> f32 {
     let ck = L::C_REF[k];
     let rho = 1.0 + drho;
     let cu = ck[0] as f32 * u[0] + ck[1] as f32 * u[1] + ck[2] as f32 * u[2];
-    g_opp + 6.0 * L::W_REF[k] * rho * cu * c.velocity_scale
+    g_opp + 6.0 * L::W_REF[k] * rho * cu * c.velocity_scale * profile
 }
 
 /// The node whose populations an outlet gives to `p` in direction `c_k`: across the face, clamped

@@ -168,6 +168,8 @@ pub struct Lbm3<const Q: usize, L: Lattice3<Q>> {
     halo_recv: Vec<f32>,
     /// The moments of the velocity and outlet faces' layers, gathered at the start of each step.
     face_moments: FaceMoments,
+    /// The velocity faces' profiles (see `Ctx::face_profiles`).
+    face_profiles: [Vec<f32>; 6],
     /// Per (body, segment, index along the split axis) force sums, before and after the ranks'
     /// sum: `[((b segments + s) n_axis + i) 3 + a]`.
     partial: Vec<f64>,
@@ -209,8 +211,8 @@ impl Plan {
             });
         }
         let (mut pulls, mut pull_start) = (Vec::new(), Vec::with_capacity(self.specials.len() + 1));
-        let none = FaceMoments::default();
-        let c = ctx::<Q>(cfg, self, &none, Relax::new(cfg.tau, 0.0), 1.0);
+        let (none, uniform) = (FaceMoments::default(), Default::default());
+        let c = ctx::<Q>(cfg, self, &none, &uniform, Relax::new(cfg.tau, 0.0), 1.0);
         let [_, ny, _] = cfg.n;
         for r in 0..self.row_start.len() - 1 {
             let (y, z) = (r % ny, r / ny);
@@ -228,7 +230,14 @@ impl Plan {
     }
 }
 
-fn ctx<'a, const Q: usize>(cfg: &'a D3Config, plan: &'a Plan, face_moments: &'a FaceMoments, relax: Relax, velocity_scale: f32) -> Ctx<'a> {
+fn ctx<'a, const Q: usize>(
+    cfg: &'a D3Config,
+    plan: &'a Plan,
+    face_moments: &'a FaceMoments,
+    face_profiles: &'a [Vec<f32>; 6],
+    relax: Relax,
+    velocity_scale: f32,
+) -> Ctx<'a> {
     Ctx {
         n: cfg.n,
         periodic: [0, 1, 2].map(|a| cfg.faces.periodic_axis(a)),
@@ -244,6 +253,7 @@ fn ctx<'a, const Q: usize>(cfg: &'a D3Config, plan: &'a Plan, face_moments: &'a 
         pulls: &plan.pulls,
         pull_start: &plan.pull_start,
         face_moments,
+        face_profiles,
         stream_stores: cfg
             .stream_stores
             .unwrap_or(cfg.n.iter().product::<usize>() * Q * 4 * 2 > STREAM_STORES_ABOVE_BYTES),
@@ -449,6 +459,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             f_next: AlignedVec::zeros_padded(cells * Q, PAD),
             plan,
             face_moments: FaceMoments::new(cfg.n, &cfg.faces),
+            face_profiles: Default::default(),
             segment_forces: vec![[0.0; 3]; bodies.len() * cfg.segments],
             body_forces: vec![[0.0; 3]; bodies.len()],
             time: 0,
@@ -543,6 +554,47 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         let [nx, ny, _] = self.cfg.n;
         let n = self.node(p);
         self.local_rho_u([n % nx, (n / nx) % ny, n / (nx * ny)])
+    }
+
+    /// The velocity of every node this process holds (its slab and ghost layers when split),
+    /// `u[a][(z ny + y) nx + x]` over the local box, zero inside bodies: `u = (j + F/2) / rho`
+    /// from the populations after the last step, in f32 (lattice units). What a passive scalar
+    /// carried by the flow reads ([`super::Thermal3`]); planes in parallel, no allocation.
+    pub fn velocity_field(&self, u: [&mut [f32]; 3]) -> Result<(), LbmError> {
+        let n = self.cfg.n;
+        let plane = n[0] * n[1];
+        let cells = plane * n[2];
+        if u.iter().any(|c| c.len() != cells) {
+            return Err(LbmError::Config {
+                field: "velocity_field",
+                message: format!("each component needs {cells} values ({:?} nodes)", n),
+            });
+        }
+        let half_force = self.cfg.body_force.map(|v| 0.5 * v as f32);
+        let (f, solid) = (&self.f[..], &self.plan.solid[..]);
+        let [ux, uy, uz] = u;
+        ux.par_chunks_mut(plane)
+            .zip(uy.par_chunks_mut(plane))
+            .zip(uz.par_chunks_mut(plane))
+            .enumerate()
+            .for_each(|(z, ((ux, uy), uz))| {
+                for y in 0..n[1] {
+                    for x in 0..n[0] {
+                        let c = y * n[0] + x;
+                        if solid[z * plane + c] {
+                            (ux[c], uy[c], uz[c]) = (0.0, 0.0, 0.0);
+                            continue;
+                        }
+                        let g: [f32; Q] = std::array::from_fn(|i| f[index::<Q>(n, [x, y, z], i)]);
+                        let (drho, j) = moments::<Q, L>(&g);
+                        let rho = 1.0 + drho;
+                        ux[c] = (j[0] + half_force[0]) / rho;
+                        uy[c] = (j[1] + half_force[1]) / rho;
+                        uz[c] = (j[2] + half_force[2]) / rho;
+                    }
+                }
+            });
+        Ok(())
     }
 
     /// The velocity of every node of the plane at global `z`, `[y nx + x]`, `None` inside bodies;
@@ -683,7 +735,14 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     pub fn step(&mut self) -> Result<(), LbmError> {
         let kernel = plane_fn::<Q, L>(self.cfg.collision, self.cfg.body_force != [0.0; 3], self.cfg.smagorinsky > 0.0);
         self.face_moments.fill::<Q, L>(self.cfg.n, &self.f);
-        let ctx = ctx::<Q>(&self.cfg, &self.plan, &self.face_moments, self.relax, self.velocity_scale);
+        let ctx = ctx::<Q>(
+            &self.cfg,
+            &self.plan,
+            &self.face_moments,
+            &self.face_profiles,
+            self.relax,
+            self.velocity_scale,
+        );
         let (src, src_ext) = (&self.f[..], self.f.padded());
         let plane_len = Q * self.cfg.n[0] * self.cfg.n[1];
         let (n, part) = (self.cfg.n, &self.part);
@@ -703,7 +762,14 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         let forced = self.cfg.body_force != [0.0; 3];
         let les = self.cfg.smagorinsky > 0.0;
         // The oracle computes what enters through the faces itself (`gather`, `face_value`).
-        let ctx = ctx::<Q>(&self.cfg, &self.plan, &self.face_moments, self.relax, self.velocity_scale);
+        let ctx = ctx::<Q>(
+            &self.cfg,
+            &self.plan,
+            &self.face_moments,
+            &self.face_profiles,
+            self.relax,
+            self.velocity_scale,
+        );
         let collide_fn: fn(&mut [f32; Q], Relax, [f32; 3]) = monomorphised!(collide, self.cfg.collision, forced, les);
         let [nx, ny, nz] = self.cfg.n;
         let mut next = vec![0.0f32; self.f.len()];
@@ -852,6 +918,37 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                 message: format!("face {face} is {}, not a velocity face", other.map_or("absent", Face::name)),
             }),
         }
+    }
+
+    /// Multiplies the velocity of face `face` at each of its nodes by `profile(x)`, `x` the
+    /// node's physical position, from the next step on (a pipe's Poiseuille inflow); refused for
+    /// a face that is not a velocity face.
+    pub fn set_face_profile(&mut self, face: usize, profile: impl Fn([f64; 3]) -> f64) -> Result<(), LbmError> {
+        if !matches!(self.global_cfg.faces.0.get(face), Some(Face::Velocity(_))) {
+            return Err(LbmError::Config {
+                field: "faces",
+                message: format!("face {face} is not a velocity face; a profile shapes an inflow"),
+            });
+        }
+        // A rank whose end of the axis is a ghost layer has no such face.
+        if !matches!(self.cfg.faces.0[face], Face::Velocity(_)) {
+            return Ok(());
+        }
+        let n = self.cfg.n;
+        let a = face / 2;
+        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+        let mut layer = vec![0.0f32; n[b] * n[c]];
+        for vc in 0..n[c] {
+            for vb in 0..n[b] {
+                let mut p = [0; 3];
+                p[a] = if face.is_multiple_of(2) { 0 } else { n[a] - 1 };
+                p[b] = vb;
+                p[c] = vc;
+                layer[FaceMoments::at(n, face, p)] = profile(self.cfg.grid.position(self.part.global(p))) as f32;
+            }
+        }
+        self.face_profiles[face] = layer;
+        Ok(())
     }
 
     /// Multiplies every velocity face by `scale` from the next step on (inlet ramps, gusts).
