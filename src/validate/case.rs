@@ -46,6 +46,7 @@ pub const BUNDLED: &[(&str, &str)] = &[
     ("square_re1000.toml", include_str!("../../benchmarks/validation/square_re1000.toml")),
     ("sphere_re100.toml", include_str!("../../benchmarks/validation/sphere_re100.toml")),
     ("sphere_re300.toml", include_str!("../../benchmarks/validation/sphere_re300.toml")),
+    ("square3d_re300.toml", include_str!("../../benchmarks/validation/square3d_re300.toml")),
 ];
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
