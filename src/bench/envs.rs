@@ -1,6 +1,11 @@
 //! `hgym bench envs`: control steps (actions) per second of each lattice-Boltzmann environment
 //! family (2D and 3D) at the coarse and default levels, with the grid, the solver steps per
 //! action and the solver rate behind them. Reset (and the one-time spin-up, cached) is not timed.
+//!
+//! 2D: the first ID of each family. 3D: every distinct grid and action (an ID whose flow set-up
+//! or control interval differs from those timed before it), each after a spin-up of 1 L/U only:
+//! a lattice-Boltzmann step costs the same whatever the flow's state, and the 3D spin-ups take
+//! minutes to hours each.
 
 use std::time::Instant;
 
@@ -40,8 +45,9 @@ pub fn families() -> Vec<String> {
     set.into_iter().collect()
 }
 
-/// Times `actions` random-sign actions on one ID per family and dimension (the first registered)
-/// at each level; `families` limits the run to those families (all when empty; see [`families`]).
+/// Times `actions` alternating-sign actions on one ID per family in 2D (the first registered) and
+/// on each distinct 3D grid (see the module documentation) at each level; `families` limits the
+/// run to those families (all when empty; see [`families`]).
 pub fn bench_envs(
     levels: &[Level],
     actions: usize,
@@ -59,9 +65,22 @@ pub fn bench_envs(
         if !families.is_empty() && !families.contains(&family) {
             continue;
         }
-        if !seen.insert((family.clone(), spec.dimension())) {
+        let key = match spec.dimension() {
+            3 => format!("{}:{}", setup.hash(), interval),
+            _ => String::new(),
+        };
+        if !seen.insert((family.clone(), spec.dimension(), key)) {
             continue;
         }
+        let spec = match spec.dimension() {
+            3 => {
+                let mut short = toml::Table::new();
+                short.insert("spin_up".into(), toml::Value::Float(1.0));
+                spec.with_overrides(&short)
+                    .map_err(|e| hgym_agents::EnvError::InvalidSpec(format!("{}: {e}", spec.id())))?
+            }
+            _ => spec,
+        };
         for &level in levels {
             let plan = setup
                 .plan(level)
@@ -99,12 +118,12 @@ pub fn bench_envs(
 
 pub fn table(rows: &[EnvBenchRow]) -> String {
     let mut s = format!(
-        "{:<26} {:<8} {:>9} {:>12} {:>10} {:>9} {:>8}\n",
+        "{:<30} {:<8} {:>9} {:>12} {:>10} {:>9} {:>8}\n",
         "ID", "level", "cells", "steps/action", "actions/s", "s/action", "MLUPS"
     );
     for r in rows {
         s += &format!(
-            "{:<26} {:<8} {:>9} {:>12} {:>10.1} {:>9.3} {:>8.0}\n",
+            "{:<30} {:<8} {:>9} {:>12} {:>10.1} {:>9.3} {:>8.0}\n",
             r.id,
             r.level,
             r.cells,
