@@ -1,7 +1,8 @@
 //! Cube family (HydroGym "Flow around a cube"): `Cube_3D_Re{300,3700}`.
 //!
 //! Set-up from the paper: a cube of side H at (8, 8, 8) in [0, 32] x [0, 16] x [0, 16] H, as the
-//! sphere (`super::sphere::in_box`: free-slip sides, the wake rake in the mid-plane). Actuation:
+//! sphere (`super::sphere::in_box`: free-slip sides and 1 H absorbing layers along them and the
+//! outlet, the wake rake in the mid-plane). Actuation:
 //! independent slot jets along the leading and trailing edges of the four lateral faces (top,
 //! bottom, and both sides), 0.2 H wide and 0.8 H long, centred 0.15 H from the edge, blowing
 //! along the face's outward normal, one action each (8 actions, bound 1.0 U, parabolic

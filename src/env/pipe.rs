@@ -184,7 +184,7 @@ pub fn stenotic_pipe_3d(re: u32) -> Env3Spec {
         episode_actions: base.episode_actions,
         spin_up: base.spin_up,
         normalization: Normalization::default(),
-        sponge: None,
+        sponges: vec![],
         gust: None,
         thermal: base.thermal,
         inflow: base.inflow,

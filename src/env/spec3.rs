@@ -179,9 +179,10 @@ pub struct Env3Spec {
     pub spin_up: f64,
     #[serde(default)]
     pub normalization: Normalization,
-    /// An absorbing layer along one x or y face (the open cavity's top).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub sponge: Option<Box<SpongeSpec>>,
+    /// Absorbing layers along x or y faces (the open cavity's top; the sphere's and cube's sides
+    /// and outlet).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sponges: Vec<SpongeSpec>,
     /// A transverse gust entering through the inlet during each episode (as in 2D).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gust: Option<GustSpec>,
@@ -254,7 +255,7 @@ impl Env3Spec {
             collision: self.collision,
             smagorinsky: self.smagorinsky,
             resolution: self.resolution.clone(),
-            sponges: self.sponge.iter().map(|s| (**s).clone()).collect(),
+            sponges: self.sponges.clone(),
             refinement: None,
             span: Some(self.span.clone()),
         }
@@ -376,7 +377,7 @@ pub fn extrude(
         episode_actions: base.episode_actions,
         spin_up: base.spin_up,
         normalization: Normalization::default(),
-        sponge: base.sponge,
+        sponges: base.sponge.into_iter().map(|s| *s).collect(),
         gust: base.gust,
         thermal: base.thermal,
         inflow: base.inflow,

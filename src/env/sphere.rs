@@ -2,7 +2,8 @@
 //!
 //! Set-up from the paper: a sphere of diameter D at (8, 8, 8) in [0, 32] x [0, 16] x [0, 16] D,
 //! uniform inflow, open outlet; the paper's lateral outlets are free-slip walls here (a 16 D
-//! wide box blocks 0.3 % of it). Actuation: eight round jets on the rear half, on the circle
+//! wide box blocks 0.3 % of it), with 1 D absorbing layers along them and the outlet, as in the
+//! validation cases (`sphere_re300.toml`). Actuation: eight round jets on the rear half, on the circle
 //! 60 degrees from the rear stagnation point (the +x axis), 45 degrees apart around it, blowing
 //! along the normal, one action each (bound 1.0 U, parabolic profile). The paper does not give
 //! their size: 15 degrees of arc from axis to rim, so the coarse level resolves a few links per
@@ -18,7 +19,7 @@ use hgym_solvers::lbm::Collision;
 use super::actuation::Ramp;
 use super::spec::{probe_grid, Normalization, RewardSpec};
 use super::spec3::{Actuation3Spec, Env3Spec, Jet3};
-use crate::flow::{BoundaryKind, BoundarySpec, DomainSpec, GeometrySpec, ResolutionSpec, SpanSpec};
+use crate::flow::{BoundaryKind, BoundarySpec, DomainSpec, EdgeName, GeometrySpec, ResolutionSpec, SpanSpec, SpongeSpec};
 
 pub const REYNOLDS: [u32; 2] = [300, 3700];
 
@@ -97,7 +98,15 @@ pub(super) fn in_box(
         episode_actions: 200,
         spin_up: 60.0,
         normalization: Normalization::default(),
-        sponge: None,
+        // The validation cases' layers: without them the box's acoustic mode between the
+        // free-slip sides rings in the lift (St 0.31 in sphere_re300 at coarse).
+        sponges: [EdgeName::South, EdgeName::North, EdgeName::East]
+            .map(|edge| SpongeSpec {
+                edge,
+                thickness: 1.0,
+                strength: 0.05,
+            })
+            .into(),
         gust: None,
         thermal: None,
         inflow: None,

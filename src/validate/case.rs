@@ -46,7 +46,11 @@ pub const BUNDLED: &[(&str, &str)] = &[
     ("square_re1000.toml", include_str!("../../benchmarks/validation/square_re1000.toml")),
     ("sphere_re100.toml", include_str!("../../benchmarks/validation/sphere_re100.toml")),
     ("sphere_re300.toml", include_str!("../../benchmarks/validation/sphere_re300.toml")),
-    ("square3d_re300.toml", include_str!("../../benchmarks/validation/square3d_re300.toml")),
+    (
+        "square3d_re300.toml",
+        include_str!("../../benchmarks/validation/square3d_re300.toml"),
+    ),
+    ("cube_re300.toml", include_str!("../../benchmarks/validation/cube_re300.toml")),
 ];
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
