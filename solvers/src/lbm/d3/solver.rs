@@ -174,6 +174,10 @@ pub struct Lbm3<const Q: usize, L: Lattice3<Q>> {
     /// sum: `[((b segments + s) n_axis + i) 3 + a]`.
     partial: Vec<f64>,
     summed: Vec<f64>,
+    /// Each link's momentum exchange in the last step, and the `partial` entry it adds to
+    /// (`3 bin`), planned once.
+    link_force: Vec<[f64; 3]>,
+    link_bin: Vec<u32>,
     relax: Relax,
     velocity_scale: f32,
     f: AlignedVec,
@@ -448,6 +452,8 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             halo_send: vec![0.0; layer],
             halo_recv: vec![0.0; layer],
             partial: vec![0.0; sums],
+            link_force: vec![[0.0; 3]; plan.links.len()],
+            link_bin: plan.links.iter().map(|l| link_bin(&part, cfg.n, cfg.segments, l)).collect(),
             summed: vec![0.0; sums],
             part,
             comm,
@@ -572,6 +578,9 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         }
         let half_force = self.cfg.body_force.map(|v| 0.5 * v as f32);
         let (f, solid) = (&self.f[..], &self.plan.solid[..]);
+        // Rows in chunks on the stack: each direction's row is read contiguously, and each node
+        // sums its populations in `moments`' order (the same values as `rho_u`).
+        const CHUNK: usize = 64;
         let [ux, uy, uz] = u;
         ux.par_chunks_mut(plane)
             .zip(uy.par_chunks_mut(plane))
@@ -579,18 +588,36 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             .enumerate()
             .for_each(|(z, ((ux, uy), uz))| {
                 for y in 0..n[1] {
-                    for x in 0..n[0] {
-                        let c = y * n[0] + x;
-                        if solid[z * plane + c] {
-                            (ux[c], uy[c], uz[c]) = (0.0, 0.0, 0.0);
-                            continue;
+                    for x0 in (0..n[0]).step_by(CHUNK) {
+                        let len = CHUNK.min(n[0] - x0);
+                        let mut drho = [0.0f32; CHUNK];
+                        let mut j = [[0.0f32; CHUNK]; 3];
+                        for i in 0..Q {
+                            let start = index::<Q>(n, [x0, y, z], i);
+                            let row = &f[start..start + len];
+                            for k in 0..len {
+                                drho[k] += row[k];
+                            }
+                            for a in 0..3 {
+                                let ca = L::C_REF[i][a];
+                                if ca != 0 {
+                                    for k in 0..len {
+                                        j[a][k] += ca as f32 * row[k];
+                                    }
+                                }
+                            }
                         }
-                        let g: [f32; Q] = std::array::from_fn(|i| f[index::<Q>(n, [x, y, z], i)]);
-                        let (drho, j) = moments::<Q, L>(&g);
-                        let rho = 1.0 + drho;
-                        ux[c] = (j[0] + half_force[0]) / rho;
-                        uy[c] = (j[1] + half_force[1]) / rho;
-                        uz[c] = (j[2] + half_force[2]) / rho;
+                        for k in 0..len {
+                            let c = y * n[0] + x0 + k;
+                            if solid[z * plane + c] {
+                                (ux[c], uy[c], uz[c]) = (0.0, 0.0, 0.0);
+                                continue;
+                            }
+                            let rho = 1.0 + drho[k];
+                            ux[c] = (j[0][k] + half_force[0]) / rho;
+                            uy[c] = (j[1][k] + half_force[1]) / rho;
+                            uz[c] = (j[2][k] + half_force[2]) / rho;
+                        }
                     }
                 }
             });
@@ -660,6 +687,9 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     /// `i = opp(k)`, summed in link order per (body, segment, index along the split axis) into
     /// `partial`. The rest-state parts `w_i c_i` cancel over a closed body, so the shifted
     /// populations give the force directly.
+    ///
+    /// The slow form, one link after the other (the oracle's); [`Self::link_forces_parallel`] is
+    /// the step's.
     fn link_forces(c: &Ctx, src: &[f32], part: &Part, segments: usize, partial: &mut [f64]) {
         partial.iter_mut().for_each(|f| *f = 0.0);
         let [nx, ny, _] = c.n;
@@ -674,6 +704,30 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             let at = ((l.body as usize * segments + s) * n_axis + g[part.axis]) * 3;
             for a in 0..3 {
                 partial[at + a] += L::C_REF[i][a] as f64 * v;
+            }
+        }
+    }
+
+    /// [`Self::link_forces`] with each link's exchange computed in parallel into `link_force`,
+    /// then added into `partial` in link order at the planned bins: the same sums, bitwise.
+    fn link_forces_parallel(c: &Ctx, src: &[f32], link_bin: &[u32], link_force: &mut [[f64; 3]], partial: &mut [f64]) {
+        let [nx, ny, _] = c.n;
+        link_force
+            .par_iter_mut()
+            .zip(c.links.par_iter())
+            .with_min_len(1024)
+            .for_each(|(out, l)| {
+                let n = l.node as usize;
+                let p = [n % nx, (n / nx) % ny, n / (nx * ny)];
+                let i = L::OPP_REF[l.k as usize];
+                let v = src[c.idx::<Q>(p, i)] as f64 + bouzidi::<Q, L>(c, src, p, l) as f64;
+                *out = L::C_REF[i].map(|ci| ci as f64 * v);
+            });
+        partial.iter_mut().for_each(|f| *f = 0.0);
+        for (&bin, f) in link_bin.iter().zip(link_force.iter()) {
+            let at = 3 * bin as usize;
+            for a in 0..3 {
+                partial[at + a] += f[a];
             }
         }
     }
@@ -750,7 +804,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             kernel(&ctx, src, src_ext, z, out);
             apply_plane(&self.sponges, out, z, n, part, &self.plan.solid);
         });
-        Self::link_forces(&ctx, src, &self.part, self.cfg.segments, &mut self.partial);
+        Self::link_forces_parallel(&ctx, src, &self.link_bin, &mut self.link_force, &mut self.partial);
         std::mem::swap(&mut self.f, &mut self.f_next);
         self.finish_step()
     }
@@ -1096,4 +1150,13 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     pub fn poison_scratch(&mut self) {
         self.f_next.iter_mut().for_each(|v| *v = f32::NAN);
     }
+}
+
+/// The entry of the force sums (`partial`, in threes) that link `l` adds to: its body, its
+/// node's segment and its node's index along the split axis.
+fn link_bin(part: &Part, n: [usize; 3], segments: usize, l: &Link) -> u32 {
+    let node = l.node as usize;
+    let g = part.global([node % n[0], (node / n[0]) % n[1], node / (n[0] * n[1])]);
+    let s = g[2] * segments / part.n_global[2];
+    ((l.body as usize * segments + s) * part.n_global[part.axis] + g[part.axis]) as u32
 }
