@@ -28,7 +28,7 @@ use hgym_solvers::lbm::{LbmError, Units};
 
 use super::actuation::{section_velocity, Jet};
 use super::family::{merged, CalibrateError, FamilySpec, FlowEnv, Spec};
-use super::seeding::{gaussian, splitmix64};
+use super::seeding::splitmix64;
 use super::spec::{ActuationSpec, RewardSpec};
 use super::spec3::{Actuation3Spec, Env3Spec};
 use super::EnvInputError;
@@ -273,9 +273,7 @@ impl LbmEnv3 {
     fn substep(&mut self) -> Result<(), LbmError> {
         if let Some(inflow) = &self.spec.inflow {
             let t = self.solver.time() as f64 * self.units.time_per_step();
-            let k = (t / self.spec.control_interval).floor().max(0.0) as u64;
-            let omega = inflow.omega(self.spec.reynolds);
-            let scale = (omega * t).sin() + inflow.noise * gaussian(self.noise_seed, k);
+            let scale = inflow.scale(self.spec.reynolds, t, self.spec.control_interval, self.noise_seed);
             self.solver.set_boundary_velocity_scale(scale);
         }
         self.solver.step()?;
@@ -309,7 +307,8 @@ impl LbmEnv3 {
             self.actuate(&a);
             out.push((0..self.spec.bodies.len()).map(|b| self.solver.wall_mass_source(b)).sum());
         }
-        self.actuate(&vec![0.0; dim]);
+        let rest = self.rest_actuation();
+        self.actuate(&rest);
         out
     }
 

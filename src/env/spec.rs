@@ -176,6 +176,25 @@ impl InflowSpec {
     pub fn omega(&self, re: f64) -> f64 {
         4.0 * self.womersley * self.womersley / re
     }
+
+    /// The inflow's scale `s(t)` at time `t` (D/U) of a run seeded `seed` at Reynolds number
+    /// `re`, its noise drawn once per control interval `interval`.
+    pub fn scale(&self, re: f64, t: f64, interval: f64, seed: u64) -> f64 {
+        let k = (t / interval).floor().max(0.0) as u64;
+        (self.omega(re) * t).sin() + self.noise * super::seeding::gaussian(seed, k)
+    }
+
+    /// The inlet an oscillatory inflow needs (Poiseuille of mean U), or the uniform one.
+    pub fn inlet(inflow: Option<&InflowSpec>) -> InletSpec {
+        match inflow {
+            None => InletSpec::default(),
+            Some(_) => InletSpec {
+                profile: Profile::Parabolic,
+                reference_velocity: VelocityReference::Mean,
+                ..InletSpec::default()
+            },
+        }
+    }
 }
 
 /// A "1 - cos" transverse gust imposed at the inflow (the paper's gust-airfoil set-up): the
@@ -246,14 +265,7 @@ impl EnvSpec {
     /// The flow this environment runs (what `FlowSetup::build` makes its solver from): a
     /// uniform inlet, or with `inflow` a Poiseuille profile of mean U whose scale oscillates.
     pub fn flow_setup(&self) -> FlowSetup {
-        let inlet = match &self.inflow {
-            None => InletSpec::default(),
-            Some(_) => InletSpec {
-                profile: Profile::Parabolic,
-                reference_velocity: VelocityReference::Mean,
-                ..InletSpec::default()
-            },
-        };
+        let inlet = InflowSpec::inlet(self.inflow.as_deref());
         FlowSetup {
             bodies: self.bodies.clone(),
             domain: self.domain.clone(),

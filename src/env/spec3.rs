@@ -17,7 +17,7 @@ use hgym_solvers::lbm::Collision;
 
 use super::actuation::Ramp;
 use super::spec::{ActuationSpec, GustSpec, InflowSpec, Normalization, RewardSpec, SpongeSpec, ThermalSpec};
-use crate::flow::{BoundarySpec, DomainSpec, FlowSetup, GeometrySpec, InletSpec, Profile, ResolutionSpec, SpanSpec, VelocityReference};
+use crate::flow::{BoundarySpec, DomainSpec, FlowSetup, GeometrySpec, ResolutionSpec, SpanSpec};
 
 /// The actuators of a 3D environment; actions in `[-1, 1]` are scaled by the bound given here.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -237,14 +237,7 @@ impl Env3Spec {
     /// The flow this environment runs: a uniform rigid inlet (with `inflow`, a pipe's
     /// Poiseuille profile of mean U whose scale oscillates) and the span.
     pub fn flow_setup(&self) -> FlowSetup {
-        let inlet = match &self.inflow {
-            None => InletSpec::default(),
-            Some(_) => InletSpec {
-                profile: Profile::Parabolic,
-                reference_velocity: VelocityReference::Mean,
-                ..InletSpec::default()
-            },
-        };
+        let inlet = InflowSpec::inlet(self.inflow.as_deref());
         FlowSetup {
             bodies: self.bodies.clone(),
             domain: self.domain.clone(),

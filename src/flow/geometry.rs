@@ -238,6 +238,12 @@ impl GeometrySpec {
         )
     }
 
+    /// Whether the body is a duct the flow runs inside (a pipe), whose inlet can carry its
+    /// laminar profile ([`Self::duct_inflow`]).
+    pub fn is_duct(&self) -> bool {
+        matches!(self, GeometrySpec::Pipe { .. })
+    }
+
     /// The laminar inflow of a duct body over its mean velocity at `p` (3D): Poiseuille's
     /// `2 (1 - (r / R)^2)` inside a pipe of radius `R` at the inlet, 0 outside it; `None` for the
     /// other shapes.

@@ -238,7 +238,7 @@ impl FlowSetup {
                 if self.refinement.is_some() {
                     return Err(bad("refinement", "3D flows run on one uniform grid; remove the refinement regions"));
                 }
-                let duct = self.bodies.iter().any(|b| b.duct_inflow([0.0; 3]).is_some());
+                let duct = self.bodies.iter().any(GeometrySpec::is_duct);
                 let shaped = self.inlet.profile == Profile::Parabolic && duct && self.inlet.reference_velocity == VelocityReference::Mean;
                 if (self.inlet.profile != Profile::Uniform && !shaped) || self.inlet.characteristic_time > 0.0 {
                     return Err(bad(

@@ -268,9 +268,9 @@ impl LbmFlow3 {
 
 impl FlowSetup {
     /// Builds the 3D solver at `plan` (a set-up with a span): faces from the boundaries and the
-    /// span, the inlet's velocity (uniform, or a pipe's Poiseuille profile), collision, subgrid viscosity, absorbing layers on the
-    /// x and y faces, the bodies as solids.
-    /// The fluid starts at rest; callers set their initial state.
+    /// span, the inlet's velocity (uniform, or a pipe's Poiseuille profile), collision, subgrid
+    /// viscosity, absorbing layers on the x and y faces, the bodies as solids. The fluid starts
+    /// at rest; callers set their initial state.
     pub fn build3(&self, plan: &FlowPlan) -> Result<LbmFlow3, FlowError> {
         let Some(span) = &self.span else {
             return Err(FlowError::Invalid {
@@ -341,7 +341,7 @@ impl FlowSetup {
         // A parabolic 3D inlet is the laminar inflow of the duct it feeds (`check` makes sure
         // there is one).
         if self.inlet.profile == Profile::Parabolic {
-            if let Some(duct) = self.bodies.iter().find(|b| b.duct_inflow([0.0; 3]).is_some()) {
+            if let Some(duct) = self.bodies.iter().find(|b| b.is_duct()) {
                 built
                     .set_face_profile(0, |p| duct.duct_inflow(p).unwrap_or(0.0))
                     .map_err(FlowError::Solver)?;
