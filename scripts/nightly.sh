@@ -32,6 +32,8 @@ step bench-agents     "$HGYM" bench agents
 step bench-kolmogorov "$HGYM" bench kolmogorov
 step bench-channel    "$HGYM" bench channel
 step bench-envs       "$HGYM" bench envs --quick
+# Gymnasium's contract on every 3D ID at coarse (make test checks each family's first).
+step contract-3d      cargo test --release --locked --test env3_contract -- --ignored
 step bench-python     "$HGYM" bench python
 for algo in ppo ddpg td3 gppo; do
   step "train-$algo" "$HGYM" train --env Kolmogorov_2D_Re40 --algo "$algo" --steps 2000 --out "$OUT/train"

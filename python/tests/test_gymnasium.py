@@ -24,8 +24,8 @@ SHORT = {"episode_actions": 3}
 SHORT_3D = {**SHORT, "spin_up": 0.1, "control_interval": 0.005}
 SHORTS = {e["id"]: SHORT_3D if e["dimension"] == 3 and e["solver"].startswith("lbm") else SHORT for e in hgym.envs()}
 # Gymnasium's checker runs over every 2D and spectral ID, and over the first 3D lattice-Boltzmann ID
-# of each family: the binding is one code path per family, and the Rust contract
-# (tests/env3_contract.rs) checks every 3D ID (each 3D check costs 6-27 s here).
+# of each family: the binding is one code path per family (each 3D check costs 3-27 s here); the
+# Rust contract checks every 3D ID in `make nightly` (tests/env3_contract.rs, an ignored test).
 FIRST_3D = {}
 for e in hgym.envs():
     if SHORTS[e["id"]] is SHORT_3D:
