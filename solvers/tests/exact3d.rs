@@ -396,7 +396,8 @@ fn oracle_case_with_faces<const Q: usize, L: Lattice3<Q>>(collision: Collision, 
 type Case<const Q: usize, L> = fn(Collision, f64) -> Lbm3<Q, L>;
 
 /// Rows a multiple of 8 long written with non-temporal stores, across several chunks of the
-/// bulk loop.
+/// bulk loop, with absorbing layers across the rows (one ending inside the second chunk) and
+/// along them (which the fast kernel applies chunk by chunk and node by node).
 fn oracle_case_streamed<const Q: usize, L: Lattice3<Q>>(collision: Collision, smagorinsky: f64) -> Lbm3<Q, L> {
     let mut cfg = D3Config::new([264, 6, 5], 0.52);
     cfg.collision = collision;
@@ -404,6 +405,14 @@ fn oracle_case_streamed<const Q: usize, L: Lattice3<Q>>(collision: Collision, sm
     cfg.stream_stores = Some(true);
     cfg.faces.0[2] = Face::Wall;
     cfg.faces.0[3] = Face::Wall;
+    let layer = |face, width| Sponge3 {
+        face,
+        width,
+        strength: 0.3,
+        rho: 1.001,
+        u: [0.03, 0.002, -0.001],
+    };
+    cfg.sponges = vec![layer(0, 140), layer(1, 20), layer(2, 2)];
     let mut s = Lbm3::<Q, L>::new(cfg, &[]).unwrap();
     s.set_equilibrium(|x, y, z| {
         (

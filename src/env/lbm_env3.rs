@@ -476,19 +476,18 @@ impl Env for LbmEnv3 {
 
     fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
         self.develop()?;
+        // `develop` leaves the flow's populations and then the temperature's (`state`).
         let state = self.attractor.as_deref().unwrap_or_default();
-        let n_flow = self.solver.populations().len();
+        let (flow, heat) = state.split_at(self.solver.populations().len().min(state.len()));
         // An oscillating inflow continues its phase from the end of the spin-up.
         let time = if self.spec.inflow.is_some() {
             self.units.steps(self.spec.spin_up)
         } else {
             0
         };
-        self.solver
-            .set_populations(&state[..n_flow.min(state.len())], time)
-            .map_err(backend)?;
+        self.solver.set_populations(flow, time).map_err(backend)?;
         if let Some(th) = &mut self.thermal {
-            th.set_populations(&state[n_flow.min(state.len())..]).map_err(backend)?;
+            th.set_populations(heat).map_err(backend)?;
         }
         self.noise_seed = seed;
         self.a_old = self.rest_actuation();

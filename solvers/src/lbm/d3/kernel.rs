@@ -15,7 +15,8 @@ pub(crate) use super::super::kernel::Special;
 use super::super::kernel::{nt_rows_possible, store_fence, stream_aligned};
 use super::collision::{collide, collide_chunk, moments, Ends, CHUNK};
 use super::lattice::Lattice3;
-use super::sides::{face_source, face_value, face_value_planned, Faces};
+use super::sides::{face_source, face_value, face_value_planned, plan_face_pull, Faces};
+use super::sponge::Layers;
 
 /// A link from fluid node `node` whose streaming source in direction `k` (the node `node - c_k`)
 /// is inside a body; the wall is at fraction `q` of the way towards it.
@@ -30,18 +31,21 @@ pub(crate) struct Link {
     pub body: u16,
 }
 
-/// What enters a special fluid node `k`-wards from beyond a face of the box, planned once:
-/// population index `src` of the step's source copied (periodic, wall and free-slip faces; see
-/// [`face_source`]), or [`FacePull::COMPUTED`] for velocity and outlet faces, whose value
-/// [`face_value`] computes from the populations of the step.
+/// What enters a special fluid node `k`-wards from beyond a face of the box, planned once.
+/// Periodic, wall and free-slip faces copy population index `src` of the step's source (`face`
+/// is [`FacePull::COPY`]; see [`face_source`]). Velocity and outlet faces compute the value
+/// ([`face_value_planned`]) from population `src` (the node's opposite one, or the one across
+/// the outlet) and the moments of node `at` of face `face`'s layer ([`FaceMoments`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct FacePull {
     pub src: u32,
+    pub at: u32,
     pub k: u8,
+    pub face: u8,
 }
 
 impl FacePull {
-    pub const COMPUTED: u32 = u32::MAX;
+    pub const COPY: u8 = u8::MAX;
 }
 
 /// The moments `(rho - 1, j)` of the nodes of the outer layer of each face whose entering values
@@ -72,25 +76,29 @@ impl FaceMoments {
         p[c] * n[b] + p[b]
     }
 
+    /// The nodes of face `f`'s layer on `n` nodes, in layer order (index [`Self::at`]).
+    pub fn layer(n: [usize; 3], f: usize) -> impl Iterator<Item = [usize; 3]> {
+        let a = f / 2;
+        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+        let pa = if f.is_multiple_of(2) { 0 } else { n[a] - 1 };
+        (0..n[c]).flat_map(move |vc| {
+            (0..n[b]).map(move |vb| {
+                let mut p = [0; 3];
+                p[a] = pa;
+                p[b] = vb;
+                p[c] = vc;
+                p
+            })
+        })
+    }
+
     /// Gathers the moments of every computed face's layer from `src`.
     pub fn fill<const Q: usize, L: Lattice3<Q>>(&mut self, n: [usize; 3], src: &[f32]) {
         for (f, layer) in self.0.iter_mut().enumerate() {
-            if layer.is_empty() {
-                continue;
-            }
-            let a = f / 2;
-            let (b, c) = ((a + 1) % 3, (a + 2) % 3);
-            for vc in 0..n[c] {
-                for vb in 0..n[b] {
-                    let mut p = [0; 3];
-                    p[a] = if f % 2 == 0 { 0 } else { n[a] - 1 };
-                    p[b] = vb;
-                    p[c] = vc;
-                    let m = &mut layer[vc * n[b] + vb];
-                    let g: [f32; Q] = std::array::from_fn(|i| src[index::<Q>(n, p, i)]);
-                    let (drho, j) = moments::<Q, L>(&g);
-                    *m = [drho, j[0], j[1], j[2]];
-                }
+            for (m, p) in layer.iter_mut().zip(Self::layer(n, f)) {
+                let g: [f32; Q] = std::array::from_fn(|i| src[index::<Q>(n, p, i)]);
+                let (drho, j) = moments::<Q, L>(&g);
+                *m = [drho, j[0], j[1], j[2]];
             }
         }
     }
@@ -129,6 +137,8 @@ pub(crate) struct Ctx<'a> {
     pub face_profiles: &'a [Vec<f32>; 6],
     /// Write the bulk with non-temporal stores (arrays larger than the caches).
     pub stream_stores: bool,
+    /// The absorbing layers, applied after each collision.
+    pub layers: Layers<'a>,
 }
 
 impl Ctx<'_> {
@@ -260,9 +270,9 @@ fn gather_planned<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p: [usiz
         }
     }
     for fp in pulls {
-        g[fp.k as usize] = match fp.src {
-            FacePull::COMPUTED => face_value_planned::<Q, L>(c, src, p, fp.k as usize),
-            i => src[i as usize],
+        g[fp.k as usize] = match fp.face {
+            FacePull::COPY => src[fp.src as usize],
+            _ => face_value_planned::<Q, L>(c, src, fp),
         };
     }
     for l in links {
@@ -275,8 +285,15 @@ fn gather_planned<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p: [usiz
 pub(crate) fn plan_pulls<const Q: usize, L: Lattice3<Q>>(c: &Ctx, p: [usize; 3], out: &mut Vec<FacePull>) {
     for i in 0..Q {
         if c.neighbour(p, L::C_REF[i].map(|v| -v)).is_none() {
-            let src = face_source::<Q, L>(c, p, i).map_or(FacePull::COMPUTED, |v| v as u32);
-            out.push(FacePull { src, k: i as u8 });
+            out.push(match face_source::<Q, L>(c, p, i) {
+                Some(src) => FacePull {
+                    src: src as u32,
+                    at: 0,
+                    k: i as u8,
+                    face: FacePull::COPY,
+                },
+                None => plan_face_pull::<Q, L>(c, p, i),
+            });
         }
     }
 }
@@ -334,6 +351,7 @@ fn bulk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const 
             t[i] = &s[i][c0..c1];
         }
         collide_chunk::<Q, L, OP, FORCED, LES>(&t, c0, c1 - c0, nx, ends, buf, c.relax, c.force);
+        c.layers.chunk(buf, c0, c1 - c0, y, z, c.n);
         for (i, b) in buf.iter().enumerate() {
             let row = (i * ny + y) * nx;
             let dst = &mut out[row + c0..row + c1];
@@ -381,6 +399,7 @@ pub(crate) fn plane<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: 
             let pulls = &c.pulls[c.pull_start[s] as usize..c.pull_start[s + 1] as usize];
             let mut g = gather_planned::<Q, L>(c, src, [x, y, z], pulls, links);
             collide::<Q, L, OP, FORCED, LES>(&mut g, c.relax, c.force);
+            c.layers.node(&mut g, [x, y, z], c.n);
             for (i, gi) in g.iter().enumerate() {
                 out[(i * ny + y) * nx + x] = *gi;
             }

@@ -4,7 +4,8 @@
 //! segment), absorbing layers on any face and trilinear probes.
 //!
 //! Same habits as the 2D kernel: shifted FP32 storage, structure of arrays (`f[((z Q + i) ny +
-//! y) nx + x]`), one fused pull-scheme stream-collide pass per step over two arrays, rayon over
+//! y) nx + x]`), one fused pull-scheme stream-collide pass per step over two arrays (absorbing
+//! layers applied inside it, before the store), rayon over
 //! z planes, no allocation in a step, and a slow oracle ([`Lbm3::step_reference`]) the fast
 //! kernel is tested against bitwise. After a step, `f` holds the post-collision populations.
 //!

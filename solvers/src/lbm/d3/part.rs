@@ -101,11 +101,13 @@ impl Part {
     }
 
     /// Global index along the split axis of local index `i`, wrapped.
+    #[inline]
     pub fn global_index(&self, i: usize) -> usize {
         (self.offset + i as isize).rem_euclid(self.n_global[self.axis] as isize) as usize
     }
 
     /// Global node of local node `p`.
+    #[inline]
     pub fn global(&self, mut p: [usize; 3]) -> [usize; 3] {
         p[self.axis] = self.global_index(p[self.axis]);
         p

@@ -3,7 +3,7 @@
 //! [`Side`](crate::lbm::Side), written for any direction of a 3D lattice.
 
 use super::collision::moments;
-use super::kernel::{Ctx, FaceMoments};
+use super::kernel::{Ctx, FaceMoments, FacePull};
 use super::lattice::Lattice3;
 
 /// What happens at one face of the box.
@@ -147,24 +147,35 @@ pub(crate) fn face_value<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p
     }
 }
 
-/// [`face_value`] for a velocity or outlet face, with the moments of the face's layer gathered
-/// for the step ([`FaceMoments`]): the same arithmetic on the same values.
-#[inline]
-pub(crate) fn face_value_planned<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], p: [usize; 3], k: usize) -> f32 {
-    let ck = L::C_REF[k];
+/// The plan of a value that a velocity or outlet face computes ([`FacePull`]): which
+/// population and which node of the face's layer [`face_value`] reads.
+pub(crate) fn plan_face_pull<const Q: usize, L: Lattice3<Q>>(c: &Ctx, p: [usize; 3], k: usize) -> FacePull {
     let f = crossed_face::<Q, L>(c, p, k).unwrap_or(0);
-    let layer = &c.face_moments.0[f];
+    let (b, i) = match &c.faces.0[f] {
+        Face::Outlet => (outlet_node(c, p, L::C_REF[k]), k),
+        _ => (p, L::OPP_REF[k]),
+    };
+    FacePull {
+        src: c.idx::<Q>(b, i) as u32,
+        at: FaceMoments::at(c.n, f, b) as u32,
+        k: k as u8,
+        face: f as u8,
+    }
+}
+
+/// [`face_value`] for a velocity or outlet face, planned ([`plan_face_pull`]) and with the
+/// moments of the face's layer gathered for the step ([`FaceMoments`]): the same arithmetic on
+/// the same values.
+#[inline]
+pub(crate) fn face_value_planned<const Q: usize, L: Lattice3<Q>>(c: &Ctx, src: &[f32], fp: &FacePull) -> f32 {
+    let (f, k, at) = (fp.face as usize, fp.k as usize, fp.at as usize);
+    let m = c.face_moments.0[f][at];
     match &c.faces.0[f] {
         Face::Velocity(u) => {
-            let drho = layer[FaceMoments::at(c.n, f, p)][0];
-            velocity_value::<Q, L>(c, k, src[c.idx::<Q>(p, L::OPP_REF[k])], drho, u, c.face_profile(f, p))
+            let profile = c.face_profiles[f].get(at).copied().unwrap_or(1.0);
+            velocity_value::<Q, L>(c, k, src[fp.src as usize], m[0], u, profile)
         }
-        Face::Outlet => {
-            let b = outlet_node(c, p, ck);
-            let m = layer[FaceMoments::at(c.n, f, b)];
-            outlet_value::<Q, L>(k, src[c.idx::<Q>(b, k)], m[0], [m[1], m[2], m[3]])
-        }
-        _ => face_value::<Q, L>(c, src, p, k),
+        _ => outlet_value::<Q, L>(k, src[fp.src as usize], m[0], [m[1], m[2], m[3]]),
     }
 }
 

@@ -12,7 +12,7 @@ use super::kernel::{bouzidi, gather, index, plan_pulls, plane, Ctx, FaceMoments,
 use super::lattice::Lattice3;
 use super::part::Part;
 use super::sides::{Face, Faces};
-use super::sponge::{apply_plane, Sponge3, Sponge3Plan};
+use super::sponge::{apply_plane, Layers, Sponge3, Sponge3Plan};
 use crate::comm::{Comm, Solo};
 use crate::geometry::Solid;
 
@@ -205,7 +205,7 @@ struct Plan {
 impl Plan {
     /// Plans the face pulls of every special fluid node (the faces of `cfg`).
     fn plan_pulls<const Q: usize, L: Lattice3<Q>>(&mut self, cfg: &D3Config) -> Result<(), LbmError> {
-        if cfg.n.iter().product::<usize>() * Q >= FacePull::COMPUTED as usize {
+        if cfg.n.iter().product::<usize>() * Q > u32::MAX as usize {
             return Err(LbmError::Config {
                 field: "n",
                 message: format!(
@@ -216,7 +216,9 @@ impl Plan {
         }
         let (mut pulls, mut pull_start) = (Vec::new(), Vec::with_capacity(self.specials.len() + 1));
         let (none, uniform) = (FaceMoments::default(), Default::default());
-        let c = ctx::<Q>(cfg, self, &none, &uniform, Relax::new(cfg.tau, 0.0), 1.0);
+        let whole = Part::whole(cfg.n);
+        let layers = Layers { plans: &[], part: &whole };
+        let c = ctx::<Q>(cfg, self, &none, &uniform, Relax::new(cfg.tau, 0.0), 1.0, layers);
         let [_, ny, _] = cfg.n;
         for r in 0..self.row_start.len() - 1 {
             let (y, z) = (r % ny, r / ny);
@@ -241,6 +243,7 @@ fn ctx<'a, const Q: usize>(
     face_profiles: &'a [Vec<f32>; 6],
     relax: Relax,
     velocity_scale: f32,
+    layers: Layers<'a>,
 ) -> Ctx<'a> {
     Ctx {
         n: cfg.n,
@@ -261,6 +264,7 @@ fn ctx<'a, const Q: usize>(
         stream_stores: cfg
             .stream_stores
             .unwrap_or(cfg.n.iter().product::<usize>() * Q * 4 * 2 > STREAM_STORES_ABOVE_BYTES),
+        layers,
     }
 }
 
@@ -652,18 +656,19 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     /// Total mass of the fluid, `sum_x sum_i f_i`: summed per index along the split axis in node
     /// order, then over the indices in order (every rank gets the same bits).
     pub fn mass(&self) -> f64 {
-        let a = self.part.axis;
-        let mut per_index = vec![0.0f64; self.part.n_global[a]];
         let [nx, ny, nz] = self.cfg.n;
-        for z in 0..nz {
-            for y in 0..ny {
-                for x in 0..nx {
-                    let l = [x, y, z];
-                    if self.part.owns(l) && !self.plan.solid[(z * ny + y) * nx + x] {
-                        per_index[self.part.global_index(l[a])] += 1.0 + self.populations(l).iter().map(|&g| g as f64).sum::<f64>();
-                    }
-                }
-            }
+        let fluid = (0..nz)
+            .flat_map(|z| (0..ny).flat_map(move |y| (0..nx).map(move |x| [x, y, z])))
+            .filter(|&l| self.part.owns(l) && !self.plan.solid[(l[2] * ny + l[1]) * nx + l[0]]);
+        self.split_sum(fluid.map(|l| (l[self.part.axis], 1.0 + self.populations(l).iter().map(|&g| g as f64).sum::<f64>())))
+    }
+
+    /// The sum of `terms` (local index along the split axis, value), bitwise the same on any
+    /// number of ranks: per global index first, then in index order (see [`super::part`]).
+    fn split_sum(&self, terms: impl Iterator<Item = (usize, f64)>) -> f64 {
+        let mut per_index = vec![0.0f64; self.part.n_global[self.part.axis]];
+        for (i, v) in terms {
+            per_index[self.part.global_index(i)] += v;
         }
         let mut summed = vec![0.0; per_index.len()];
         self.comm.sum(&per_index, &mut summed);
@@ -796,14 +801,17 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             &self.face_profiles,
             self.relax,
             self.velocity_scale,
+            Layers {
+                plans: &self.sponges,
+                part: &self.part,
+            },
         );
         let (src, src_ext) = (&self.f[..], self.f.padded());
         let plane_len = Q * self.cfg.n[0] * self.cfg.n[1];
-        let (n, part) = (self.cfg.n, &self.part);
-        self.f_next.par_chunks_mut(plane_len).enumerate().for_each(|(z, out)| {
-            kernel(&ctx, src, src_ext, z, out);
-            apply_plane(&self.sponges, out, z, n, part, &self.plan.solid);
-        });
+        self.f_next
+            .par_chunks_mut(plane_len)
+            .enumerate()
+            .for_each(|(z, out)| kernel(&ctx, src, src_ext, z, out));
         Self::link_forces_parallel(&ctx, src, &self.link_bin, &mut self.link_force, &mut self.partial);
         std::mem::swap(&mut self.f, &mut self.f_next);
         self.finish_step()
@@ -815,7 +823,8 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     pub fn step_reference(&mut self) -> Result<(), LbmError> {
         let forced = self.cfg.body_force != [0.0; 3];
         let les = self.cfg.smagorinsky > 0.0;
-        // The oracle computes what enters through the faces itself (`gather`, `face_value`).
+        // The oracle computes what enters through the faces itself (`gather`, `face_value`)
+        // and applies the layers in a pass of its own (`apply_plane`).
         let ctx = ctx::<Q>(
             &self.cfg,
             &self.plan,
@@ -823,6 +832,10 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             &self.face_profiles,
             self.relax,
             self.velocity_scale,
+            Layers {
+                plans: &self.sponges,
+                part: &self.part,
+            },
         );
         let collide_fn: fn(&mut [f32; Q], Relax, [f32; 3]) = monomorphised!(collide, self.cfg.collision, forced, les);
         let [nx, ny, nz] = self.cfg.n;
@@ -988,20 +1001,9 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         if !matches!(self.cfg.faces.0[face], Face::Velocity(_)) {
             return Ok(());
         }
-        let n = self.cfg.n;
-        let a = face / 2;
-        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
-        let mut layer = vec![0.0f32; n[b] * n[c]];
-        for vc in 0..n[c] {
-            for vb in 0..n[b] {
-                let mut p = [0; 3];
-                p[a] = if face.is_multiple_of(2) { 0 } else { n[a] - 1 };
-                p[b] = vb;
-                p[c] = vc;
-                layer[FaceMoments::at(n, face, p)] = profile(self.cfg.grid.position(self.part.global(p))) as f32;
-            }
-        }
-        self.face_profiles[face] = layer;
+        self.face_profiles[face] = FaceMoments::layer(self.cfg.n, face)
+            .map(|p| profile(self.cfg.grid.position(self.part.global(p))) as f32)
+            .collect();
         Ok(())
     }
 
@@ -1030,20 +1032,16 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     /// the forces are (per index along the split axis, then in order).
     pub fn wall_mass_source(&self, b: usize) -> f64 {
         let [nx, ny, _] = self.cfg.n;
-        let axis = self.part.axis;
-        let mut per_index = vec![0.0f64; self.part.n_global[axis]];
-        for l in self.plan.links.iter().filter(|l| l.body as usize == b) {
+        let terms = self.plan.links.iter().filter(|l| l.body as usize == b).map(|l| {
             let n = l.node as usize;
             let p = [n % nx, (n / nx) % ny, n / (nx * ny)];
             let k = l.k as usize;
             let c = L::C_REF[k];
             let cu: f64 = (0..3).map(|a| c[a] as f64 * l.uw[a] as f64).sum();
             let term = 6.0 * L::W_REF[k] as f64 * cu;
-            per_index[self.part.global_index(p[axis])] += if l.q < 0.5 { term } else { term / (2.0 * l.q as f64) };
-        }
-        let mut summed = vec![0.0; per_index.len()];
-        self.comm.sum(&per_index, &mut summed);
-        summed.iter().sum()
+            (p[self.part.axis], if l.q < 0.5 { term } else { term / (2.0 * l.q as f64) })
+        });
+        self.split_sum(terms)
     }
 
     /// Density and velocity at the physical point `x`, trilinear between the eight nodes

@@ -4,7 +4,9 @@
 //! the target state, `g_i <- g_i - sigma(d) (g_i - g_i^eq(rho_0, u_0))`,
 //! `sigma(d) = sigma_max d^2`.
 
-use super::collision::equilibrium;
+use std::ops::Range;
+
+use super::collision::{equilibrium, CHUNK};
 use super::lattice::Lattice3;
 use super::part::Part;
 
@@ -44,10 +46,16 @@ impl Sponge3Plan {
     /// `sigma` at node `p` of a box of `n` nodes, zero outside the layer.
     pub fn sigma(&self, p: [usize; 3], n: [usize; 3]) -> f32 {
         let a = self.face / 2;
+        self.sigma_at(p[a], n[a])
+    }
+
+    /// `sigma` at index `v` along the layer's axis of `n` nodes.
+    #[inline]
+    fn sigma_at(&self, v: usize, n: usize) -> f32 {
         let depth = if self.face.is_multiple_of(2) {
-            self.width as isize - p[a] as isize
+            self.width as isize - v as isize
         } else {
-            p[a] as isize + self.width as isize + 1 - n[a] as isize
+            v as isize + self.width as isize + 1 - n as isize
         };
         if depth <= 0 {
             return 0.0;
@@ -57,40 +65,120 @@ impl Sponge3Plan {
     }
 }
 
+impl Sponge3Plan {
+    /// The local indices along axis `a` of a rank's box of `n` nodes (its slab `part` of the
+    /// global box) that the layer covers: all of them along the other axes. Unwrapped: a ghost
+    /// layer may be left out, the exchange overwrites it.
+    fn local_range(&self, a: usize, n: [usize; 3], part: &Part) -> Range<usize> {
+        let ng = part.n_global;
+        let (lo, hi) = if a != self.face / 2 {
+            return 0..n[a];
+        } else if self.face.is_multiple_of(2) {
+            (0, self.width.min(ng[a]))
+        } else {
+            (ng[a].saturating_sub(self.width), ng[a])
+        };
+        let offset = if a == part.axis { part.offset } else { 0 };
+        let local = |g: usize| (g as isize - offset).clamp(0, n[a] as isize) as usize;
+        local(lo)..local(hi)
+    }
+
+    /// `sigma` at local index `v` along the layer's axis of a rank's slab `part`, inside the
+    /// layer's local range.
+    #[inline]
+    fn sigma_along(&self, v: usize, part: &Part) -> f32 {
+        let a = self.face / 2;
+        let g = if a == part.axis { part.global_index(v) } else { v };
+        self.sigma_at(g, part.n_global[a])
+    }
+
+    /// `sigma` at local node `p` of a rank's box of `n` nodes, zero outside the layer.
+    fn sigma_local(&self, p: [usize; 3], n: [usize; 3], part: &Part) -> f32 {
+        if (0..3).all(|a| self.local_range(a, n, part).contains(&p[a])) {
+            self.sigma_along(p[self.face / 2], part)
+        } else {
+            0.0
+        }
+    }
+
+    /// `g <- g - sigma (g - g^eq)` for population `i` (nothing where `sigma` is zero).
+    #[inline(always)]
+    fn relax(&self, g: &mut f32, i: usize, sigma: f32) {
+        if sigma != 0.0 {
+            *g -= sigma * (*g - self.g_eq[i]);
+        }
+    }
+}
+
+/// The absorbing layers as the step's kernel applies them: to each chunk of a row's bulk loop
+/// before it is stored ([`Self::chunk`]) and to each special fluid node after its collision
+/// ([`Self::node`]), so that the layers cost no extra pass over memory (applied after a
+/// non-temporal store they read it all back: half the time of the cylinder's 3D step went there).
+/// Both give bitwise what [`apply_plane`] gives.
+#[derive(Clone, Copy)]
+pub(crate) struct Layers<'a> {
+    pub plans: &'a [Sponge3Plan],
+    pub part: &'a Part,
+}
+
+impl Layers<'_> {
+    /// Applies every layer to nodes `x0 .. x0 + m` of row `(y, z)` of a box of `n` nodes held in
+    /// `buf[i][x - x0]`. Solid and ghost nodes get values too; the specials overwrite them.
+    #[inline]
+    pub fn chunk<const Q: usize>(&self, buf: &mut [[f32; CHUNK]; Q], x0: usize, m: usize, y: usize, z: usize, n: [usize; 3]) {
+        for p in self.plans {
+            if !p.local_range(1, n, self.part).contains(&y) || !p.local_range(2, n, self.part).contains(&z) {
+                continue;
+            }
+            let xr = p.local_range(0, n, self.part);
+            let (lo, hi) = (xr.start.max(x0), xr.end.min(x0 + m));
+            if lo >= hi {
+                continue;
+            }
+            let mut sigma = [0.0f32; CHUNK];
+            for x in lo..hi {
+                sigma[x - x0] = p.sigma_along([x, y, z][p.face / 2], self.part);
+            }
+            // Inside its range a layer's sigma is never zero: `relax` without its test, so
+            // that the loop vectorises.
+            let sigma = &sigma[lo - x0..hi - x0];
+            for (row, e) in buf.iter_mut().zip(&p.g_eq) {
+                for (g, s) in row[lo - x0..hi - x0].iter_mut().zip(sigma) {
+                    *g -= s * (*g - e);
+                }
+            }
+        }
+    }
+
+    /// Applies every layer to the populations `g` of fluid node `q` of a box of `n` nodes.
+    #[inline]
+    pub fn node(&self, g: &mut [f32], q: [usize; 3], n: [usize; 3]) {
+        for p in self.plans {
+            let sigma = p.sigma_local(q, n, self.part);
+            for (i, gi) in g.iter_mut().enumerate() {
+                p.relax(gi, i, sigma);
+            }
+        }
+    }
+}
+
 /// Applies every layer to the post-collision populations of plane `z` (`plane[(i ny + y) nx + x]`)
-/// of this rank's box of `n` nodes (its slab of the global box, `part`). Solid nodes are left
-/// alone. Allocates nothing.
+/// of this rank's box of `n` nodes (its slab of the global box, `part`) in a pass of its own:
+/// the oracle's way ([`Layers`] is the step's). Solid nodes are left alone. Allocates nothing.
 pub(crate) fn apply_plane(plans: &[Sponge3Plan], plane: &mut [f32], z: usize, n: [usize; 3], part: &Part, solid: &[bool]) {
     let [nx, ny, _] = n;
-    let ng = part.n_global;
-    // Local index along each axis of global index `g` (unwrapped: a ghost layer may be left
-    // out, the exchange overwrites it).
-    let offset = |a: usize| if a == part.axis { part.offset } else { 0 };
     for p in plans {
-        // The local nodes of the layer along its axis, all of them along the others.
-        let range = |a: usize| {
-            let (lo, hi) = if a != p.face / 2 {
-                return 0..n[a];
-            } else if p.face.is_multiple_of(2) {
-                (0, p.width.min(ng[a]))
-            } else {
-                (ng[a].saturating_sub(p.width), ng[a])
-            };
-            let local = |g: usize| (g as isize - offset(a)).clamp(0, n[a] as isize) as usize;
-            local(lo)..local(hi)
-        };
-        if !range(2).contains(&z) {
+        if !p.local_range(2, n, part).contains(&z) {
             continue;
         }
-        for y in range(1) {
-            for x in range(0) {
-                let s = p.sigma(part.global([x, y, z]), ng);
-                if s == 0.0 || solid[(z * ny + y) * nx + x] {
+        for y in p.local_range(1, n, part) {
+            for x in p.local_range(0, n, part) {
+                let s = p.sigma(part.global([x, y, z]), part.n_global);
+                if solid[(z * ny + y) * nx + x] {
                     continue;
                 }
-                for (i, e) in p.g_eq.iter().enumerate() {
-                    let g = &mut plane[(i * ny + y) * nx + x];
-                    *g -= s * (*g - e);
+                for i in 0..p.g_eq.len() {
+                    p.relax(&mut plane[(i * ny + y) * nx + x], i, s);
                 }
             }
         }
