@@ -51,6 +51,10 @@ pub const BUNDLED: &[(&str, &str)] = &[
         include_str!("../../benchmarks/validation/square3d_re300.toml"),
     ),
     ("cube_re300.toml", include_str!("../../benchmarks/validation/cube_re300.toml")),
+    (
+        "cylinder3d_re200.toml",
+        include_str!("../../benchmarks/validation/cylinder3d_re200.toml"),
+    ),
 ];
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
