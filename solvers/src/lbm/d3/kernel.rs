@@ -10,6 +10,8 @@
 //! row's specials (its two ends at a non-periodic x face, and every node that is solid or has a
 //! link into a body) then run the general path and overwrite their values.
 
+use rayon::prelude::*;
+
 use super::super::collision::Relax;
 pub(crate) use super::super::kernel::Special;
 use super::super::kernel::{nt_rows_possible, store_fence, stream_aligned};
@@ -78,28 +80,37 @@ impl FaceMoments {
 
     /// The nodes of face `f`'s layer on `n` nodes, in layer order (index [`Self::at`]).
     pub fn layer(n: [usize; 3], f: usize) -> impl Iterator<Item = [usize; 3]> {
-        let a = f / 2;
-        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
-        let pa = if f.is_multiple_of(2) { 0 } else { n[a] - 1 };
-        (0..n[c]).flat_map(move |vc| {
-            (0..n[b]).map(move |vb| {
-                let mut p = [0; 3];
-                p[a] = pa;
-                p[b] = vb;
-                p[c] = vc;
-                p
-            })
-        })
+        let b = (f / 2 + 1) % 3;
+        (0..n[(f / 2 + 2) % 3]).flat_map(move |vc| (0..n[b]).map(move |vb| Self::node(n, f, vb, vc)))
     }
 
-    /// Gathers the moments of every computed face's layer from `src`.
+    /// Node `vc n_b + vb` of face `f`'s layer (`b`, `c` the axes after the face's own).
+    #[inline(always)]
+    fn node(n: [usize; 3], f: usize, vb: usize, vc: usize) -> [usize; 3] {
+        let a = f / 2;
+        let mut p = [0; 3];
+        p[a] = if f.is_multiple_of(2) { 0 } else { n[a] - 1 };
+        p[(a + 1) % 3] = vb;
+        p[(a + 2) % 3] = vc;
+        p
+    }
+
+    /// Gathers the moments of every computed face's layer from `src`, a line of the layer per
+    /// task: each node's populations lie on as many cache lines, so the gather waits on memory.
     pub fn fill<const Q: usize, L: Lattice3<Q>>(&mut self, n: [usize; 3], src: &[f32]) {
         for (f, layer) in self.0.iter_mut().enumerate() {
-            for (m, p) in layer.iter_mut().zip(Self::layer(n, f)) {
-                let g: [f32; Q] = std::array::from_fn(|i| src[index::<Q>(n, p, i)]);
-                let (drho, j) = moments::<Q, L>(&g);
-                *m = [drho, j[0], j[1], j[2]];
+            if layer.is_empty() {
+                continue;
             }
+            let nb = n[(f / 2 + 1) % 3];
+            layer.par_chunks_mut(nb).enumerate().with_min_len(4).for_each(|(vc, line)| {
+                for (vb, m) in line.iter_mut().enumerate() {
+                    let p = Self::node(n, f, vb, vc);
+                    let g: [f32; Q] = std::array::from_fn(|i| src[index::<Q>(n, p, i)]);
+                    let (drho, j) = moments::<Q, L>(&g);
+                    *m = [drho, j[0], j[1], j[2]];
+                }
+            });
         }
     }
 }
