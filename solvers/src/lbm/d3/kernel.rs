@@ -362,7 +362,7 @@ fn bulk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const 
             t[i] = &s[i][c0..c1];
         }
         collide_chunk::<Q, L, OP, FORCED, LES>(&t, c0, c1 - c0, nx, ends, buf, c.relax, c.force);
-        c.layers.chunk(buf, c0, c1 - c0, y, z, c.n);
+        c.layers.chunk(buf, c0, c1 - c0, y, z);
         for (i, b) in buf.iter().enumerate() {
             let row = (i * ny + y) * nx;
             let dst = &mut out[row + c0..row + c1];
@@ -410,7 +410,7 @@ pub(crate) fn plane<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: 
             let pulls = &c.pulls[c.pull_start[s] as usize..c.pull_start[s + 1] as usize];
             let mut g = gather_planned::<Q, L>(c, src, [x, y, z], pulls, links);
             collide::<Q, L, OP, FORCED, LES>(&mut g, c.relax, c.force);
-            c.layers.node(&mut g, [x, y, z], c.n);
+            c.layers.node(&mut g, [x, y, z]);
             for (i, gi) in g.iter().enumerate() {
                 out[(i * ny + y) * nx + x] = *gi;
             }

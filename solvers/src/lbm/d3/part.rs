@@ -101,13 +101,20 @@ impl Part {
     }
 
     /// Global index along the split axis of local index `i`, wrapped.
-    #[inline]
     pub fn global_index(&self, i: usize) -> usize {
         (self.offset + i as isize).rem_euclid(self.n_global[self.axis] as isize) as usize
     }
 
+    /// Global index along axis `a` of local index `i` (wrapped along the split axis).
+    pub fn global_index_along(&self, a: usize, i: usize) -> usize {
+        if a == self.axis {
+            self.global_index(i)
+        } else {
+            i
+        }
+    }
+
     /// Global node of local node `p`.
-    #[inline]
     pub fn global(&self, mut p: [usize; 3]) -> [usize; 3] {
         p[self.axis] = self.global_index(p[self.axis]);
         p

@@ -216,9 +216,7 @@ impl Plan {
         }
         let (mut pulls, mut pull_start) = (Vec::new(), Vec::with_capacity(self.specials.len() + 1));
         let (none, uniform) = (FaceMoments::default(), Default::default());
-        let whole = Part::whole(cfg.n);
-        let layers = Layers { plans: &[], part: &whole };
-        let c = ctx::<Q>(cfg, self, &none, &uniform, Relax::new(cfg.tau, 0.0), 1.0, layers);
+        let c = ctx::<Q>(cfg, self, &none, &uniform, Relax::new(cfg.tau, 0.0), 1.0, Layers(&[]));
         let [_, ny, _] = cfg.n;
         for r in 0..self.row_start.len() - 1 {
             let (y, z) = (r % ny, r / ny);
@@ -458,11 +456,11 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             partial: vec![0.0; sums],
             link_force: vec![[0.0; 3]; plan.links.len()],
             link_bin: plan.links.iter().map(|l| link_bin(&part, cfg.n, cfg.segments, l)).collect(),
+            sponges: cfg.sponges.iter().map(|s| Sponge3Plan::new::<Q, L>(s, &part)).collect(),
             summed: vec![0.0; sums],
             part,
             comm,
             global_cfg,
-            sponges: cfg.sponges.iter().map(Sponge3Plan::new::<Q, L>).collect(),
             relax: Relax::new(cfg.tau, cfg.smagorinsky),
             velocity_scale: 1.0,
             f: AlignedVec::zeros_padded(cells * Q, PAD),
@@ -801,10 +799,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             &self.face_profiles,
             self.relax,
             self.velocity_scale,
-            Layers {
-                plans: &self.sponges,
-                part: &self.part,
-            },
+            Layers(&self.sponges),
         );
         let (src, src_ext) = (&self.f[..], self.f.padded());
         let plane_len = Q * self.cfg.n[0] * self.cfg.n[1];
@@ -832,10 +827,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             &self.face_profiles,
             self.relax,
             self.velocity_scale,
-            Layers {
-                plans: &self.sponges,
-                part: &self.part,
-            },
+            Layers(&self.sponges),
         );
         let collide_fn: fn(&mut [f32; Q], Relax, [f32; 3]) = monomorphised!(collide, self.cfg.collision, forced, les);
         let [nx, ny, nz] = self.cfg.n;
