@@ -435,7 +435,10 @@ fn an_unseen_case_file_runs_and_passes() {
         .find(|q| q["name"] == "strouhal")
         .unwrap();
     assert!(st["measured"].is_null());
-    for plot in ["forces.png", "spectrum.png", "vorticity.png"] {
+    // The recirculation bubble behind it, from the mean wake on its centreline.
+    let l_r = measured(&report, "recirculation_length");
+    assert!((0.8..0.9).contains(&l_r), "L_r / D = {l_r}");
+    for plot in ["forces.png", "spectrum.png", "vorticity.png", "wake.png"] {
         assert!(out.join("schaefer_turek_2d1").join(plot).exists());
     }
     // The force history re-analyses to the report: its mean drag over the report's window.

@@ -216,6 +216,22 @@ impl GeometrySpec {
         }
     }
 
+    /// The wake's centreline behind a bluff body: the body's base (its downstream end on the
+    /// centreline, `x = centre + L/2`) and the line's `(y, z)`, with `z = None` for a section
+    /// extruded along a span (the line is averaged over the span). `None` for bodies without a
+    /// wake on an axis of symmetry (an aerofoil, a cavity, a channel).
+    pub fn wake_axis(&self) -> Option<(f64, f64, Option<f64>)> {
+        match self {
+            GeometrySpec::Circle { center, diameter: l } | GeometrySpec::Square { center, side: l } => {
+                Some((center[0] + 0.5 * l, center[1], None))
+            }
+            GeometrySpec::Sphere { center, diameter: l } | GeometrySpec::Cube { center, side: l } => {
+                Some((center[0] + 0.5 * l, center[1], Some(center[2])))
+            }
+            _ => None,
+        }
+    }
+
     /// Whether the body stands free in the flow (circle, square, aerofoil), as opposed to a wall
     /// feature that reaches the domain's edges (a cavity's plate, a stenosed channel's walls).
     pub fn is_immersed(&self) -> bool {

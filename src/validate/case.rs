@@ -55,6 +55,10 @@ pub const BUNDLED: &[(&str, &str)] = &[
         "cylinder3d_re200.toml",
         include_str!("../../benchmarks/validation/cylinder3d_re200.toml"),
     ),
+    (
+        "cylinder3d_re3900.toml",
+        include_str!("../../benchmarks/validation/cylinder3d_re3900.toml"),
+    ),
 ];
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -154,6 +158,10 @@ pub enum Quantity {
     MeanCd2,
     #[serde(rename = "mean_cd_3")]
     MeanCd3,
+    /// Mean recirculation length `L_r / L`: from the body's base to where the time-averaged
+    /// streamwise velocity on the wake's centreline (averaged along an extruded body's span)
+    /// turns from negative to positive.
+    RecirculationLength,
 }
 
 /// Which force component a per-body quantity averages.
@@ -178,6 +186,7 @@ impl Quantity {
             Quantity::MeanCd1 => "mean_cd_1",
             Quantity::MeanCd2 => "mean_cd_2",
             Quantity::MeanCd3 => "mean_cd_3",
+            Quantity::RecirculationLength => "recirculation_length",
         }
     }
 
@@ -426,6 +435,16 @@ impl LoadedCase {
             }
         }
         for q in &c.measure.quantities {
+            if *q == Quantity::RecirculationLength && c.geometry.wake_axis().is_none() {
+                return Err(bad(
+                    name,
+                    "measure.quantities",
+                    format!(
+                        "'recirculation_length' needs a bluff body with a wake axis (circle, square, sphere, cube), not a {}",
+                        c.geometry.name()
+                    ),
+                ));
+            }
             if let Some((b, _)) = q.body() {
                 if b > c.more_bodies.len() {
                     return Err(bad(

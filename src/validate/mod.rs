@@ -14,6 +14,7 @@ pub mod channel;
 pub mod report;
 pub mod run;
 pub mod series;
+pub mod wake;
 
 use std::path::{Path, PathBuf};
 

@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::analysis::{analyse, spectrum, standard_error, Analysis};
 use super::case::{Component, LoadedCase, Quantity};
 use super::run::{RunOutput, RunStatus};
+use super::wake::recirculation_length;
 use crate::report::manifest::{manifest, Manifest};
 use crate::report::plots;
 
@@ -179,6 +180,7 @@ fn measured(a: &Analysis, q: Quantity, out: &RunOutput) -> Option<f64> {
         Quantity::ClAmplitude => Some(a.cl_amplitude),
         Quantity::ClRms => Some(a.cl_rms),
         Quantity::CdAmplitude => Some(a.cd_amplitude),
+        Quantity::RecirculationLength => out.wake.as_ref().and_then(recirculation_length),
         Quantity::MeanCl1 | Quantity::MeanCl2 | Quantity::MeanCl3 | Quantity::MeanCd1 | Quantity::MeanCd2 | Quantity::MeanCd3 => None,
     }
     .filter(|v| v.is_finite())
@@ -192,7 +194,8 @@ impl ValidationReport {
         let mut quantities = Vec::new();
         for &q in &case.measure.quantities {
             let m = if diverged { None } else { measured(&a, q, out) };
-            let batches: Vec<f64> = if m.is_some() {
+            // The wake is averaged over the whole window only, not per batch.
+            let batches: Vec<f64> = if m.is_some() && q != Quantity::RecirculationLength {
                 a.batches.iter().map_while(|b| measured(b, q, out)).collect()
             } else {
                 vec![]
@@ -296,7 +299,11 @@ impl ValidationReport {
                 window: a.window,
                 lift_peaks: a.lift_peaks.clone(),
             },
-            plots: vec!["forces.png".into(), "spectrum.png".into(), "vorticity.png".into()],
+            plots: ["forces.png", "spectrum.png", "vorticity.png"]
+                .into_iter()
+                .chain(out.wake.as_ref().map(|_| "wake.png"))
+                .map(String::from)
+                .collect(),
             manifest: manifest(threads, out.wall_time_s),
         }
     }
@@ -382,7 +389,7 @@ impl ValidationReport {
             );
         }
         s += &format!(
-            "  {:<14} {:>10} {:>9} {:>10} {:>10} {:>10}  {}\n",
+            "  {:<20} {:>10} {:>9} {:>10} {:>10} {:>10}  {}\n",
             "quantity", "measured", "s.e.", "reference", "deviation", "tolerance", "result"
         );
         for q in &self.quantities {
@@ -405,7 +412,7 @@ impl ValidationReport {
                 (None, _) => "(info)",
             };
             s += &format!(
-                "  {:<14} {:>10} {:>9} {:>10} {:>10} {:>10}  {}\n",
+                "  {:<20} {:>10} {:>9} {:>10} {:>10} {:>10}  {}\n",
                 q.name,
                 num(q.measured),
                 q.standard_error_text().unwrap_or_else(|| "-".into()),
@@ -499,6 +506,29 @@ pub fn write_plots(r: &ValidationReport, out: &RunOutput, dir: &Path) -> Result<
         &dir.join("vorticity.png"),
         &format!("{}: vorticity w L/U at t = {t_end:.1}", r.case),
     )?;
+    if let Some(w) = &out.wake {
+        let zero = vec![0.0; w.x.len()];
+        plots::lines(
+            &dir.join("wake.png"),
+            &format!("{}: mean streamwise velocity on the wake's centreline ({} samples)", r.case, w.samples),
+            "x / L behind the base",
+            "mean u / U",
+            &[
+                plots::Line {
+                    label: "mean u / U",
+                    x: &w.x,
+                    y: &w.u,
+                    band: None,
+                },
+                plots::Line {
+                    label: "0",
+                    x: &w.x,
+                    y: &zero,
+                    band: None,
+                },
+            ],
+        )?;
+    }
     Ok(())
 }
 
@@ -541,6 +571,7 @@ mod tests {
                 extent: [0.0; 4],
                 values: vec![],
             },
+            wake: None,
             status: RunStatus::Completed,
             wall_time_s: 0.0,
             steps: 0,

@@ -11,7 +11,8 @@ use std::time::Instant;
 
 use hgym_solvers::lbm::LbmError;
 
-use super::case::{flow_error, Level, LoadedCase};
+use super::case::{flow_error, Level, LoadedCase, Quantity};
+use super::wake::{Wake, WakeSampler, SAMPLE_EVERY};
 use super::ValidateError;
 use crate::flow::{plane_vorticity, vorticity_field, Field, FlowError, FlowPlan, FlowSetup, LbmFlow, LbmFlow3};
 use hgym_solvers::lbm::Units;
@@ -87,6 +88,8 @@ pub struct RunOutput {
     pub cd_bodies: Vec<Vec<f64>>,
     pub cl_bodies: Vec<Vec<f64>>,
     pub vorticity: Field,
+    /// The mean wake on the centreline, when the case measures its recirculation length.
+    pub wake: Option<Wake>,
     pub status: RunStatus,
     pub wall_time_s: f64,
     pub steps: u64,
@@ -135,6 +138,12 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
         Some(_) => setup.reference_area() * n * n,
     };
     let coef = 0.5 * u * u * area;
+    let mut wake = if case.measure.quantities.contains(&Quantity::RecirculationLength) {
+        WakeSampler::new(&setup, n, &solver.span_nodes())
+    } else {
+        None
+    };
+    let wake_every = ((SAMPLE_EVERY * steps_per_time).round() as u64).max(1);
     let started = Instant::now();
     let mut status = RunStatus::Completed;
     let report_every = 250u64;
@@ -169,6 +178,10 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
         });
         cd.push(sum_x / coef);
         cl.push(sum_y / coef);
+        if let Some(w) = wake.as_mut().filter(|_| s + 1 > plan.spin_up_steps && (s + 1) % wake_every == 0) {
+            let ux = solver.streamwise(w.points()).map_err(|e| flow_error(&case.case.name, FlowError::Solver(e)))?;
+            w.add(ux.into_iter().map(|v| v / u));
+        }
         if (s + 1) % report_every == 0 {
             progress(s + 1, total);
         }
@@ -186,6 +199,7 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
         cd_bodies,
         cl_bodies,
         vorticity,
+        wake: wake.map(|w| w.finish()),
         status,
         wall_time_s: wall,
         steps,
@@ -246,6 +260,28 @@ impl Solver {
         match self {
             Solver::Flat(s) => s.body_forces().iter().enumerate().for_each(|(b, v)| f(b, v[0], v[1])),
             Solver::Span(s) => s.body_forces().iter().enumerate().for_each(|(b, v)| f(b, v[0], v[1])),
+        }
+    }
+
+    /// Node positions along the span (none in 2D).
+    fn span_nodes(&self) -> Vec<f64> {
+        match self {
+            Solver::Flat(_) => vec![],
+            Solver::Span(s) => {
+                let grid = s.grid();
+                (0..s.n()[2]).map(|k| grid.position([0, 0, k])[2]).collect()
+            }
+        }
+    }
+
+    /// Streamwise lattice velocity at each point (`z` ignored in 2D; the coarse grid's there).
+    fn streamwise(&mut self, points: &[[f64; 3]]) -> Result<Vec<f64>, LbmError> {
+        match self {
+            Solver::Flat(s) => {
+                s.sync();
+                points.iter().map(|p| s.coarse().probe([p[0], p[1]]).map(|v| v[1])).collect()
+            }
+            Solver::Span(s) => Ok(s.probes(points)?.into_iter().map(|(_, v)| v[0]).collect()),
         }
     }
 
