@@ -59,6 +59,10 @@ pub const BUNDLED: &[(&str, &str)] = &[
         "cylinder3d_re3900.toml",
         include_str!("../../benchmarks/validation/cylinder3d_re3900.toml"),
     ),
+    (
+        "pinball3d_re100.toml",
+        include_str!("../../benchmarks/validation/pinball3d_re100.toml"),
+    ),
 ];
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
