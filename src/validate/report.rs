@@ -510,7 +510,10 @@ pub fn write_plots(r: &ValidationReport, out: &RunOutput, dir: &Path) -> Result<
         let zero = vec![0.0; w.x.len()];
         plots::lines(
             &dir.join("wake.png"),
-            &format!("{}: mean streamwise velocity on the wake's centreline ({} samples)", r.case, w.samples),
+            &format!(
+                "{}: mean streamwise velocity on the wake's centreline ({} samples)",
+                r.case, w.samples
+            ),
             "x / L behind the base",
             "mean u / U",
             &[

@@ -179,7 +179,9 @@ pub fn run(c: &LoadedCase, plan: &Plan, progress: &mut dyn FnMut(u64, u64)) -> R
         cd.push(sum_x / coef);
         cl.push(sum_y / coef);
         if let Some(w) = wake.as_mut().filter(|_| s + 1 > plan.spin_up_steps && (s + 1) % wake_every == 0) {
-            let ux = solver.streamwise(w.points()).map_err(|e| flow_error(&case.case.name, FlowError::Solver(e)))?;
+            let ux = solver
+                .streamwise(w.points())
+                .map_err(|e| flow_error(&case.case.name, FlowError::Solver(e)))?;
             w.add(ux.into_iter().map(|v| v / u));
         }
         if (s + 1) % report_every == 0 {
