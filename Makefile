@@ -86,9 +86,10 @@ $(CARGO_TARGET_DIR)/stream_copy: benchmarks/stream/copy.c
 	$(CC) -O3 -march=native -fopenmp $< -o $@
 
 # The solver split over MPI ranks (the `mpi` feature, rsmpi): Debian's Open MPI and libclang (for
-# rsmpi's bindings) are installed if missing. Two checks, 2 and 3 ranks against one process,
-# bitwise (exit 1 if they differ): the solver alone (examples/mpi_split.rs), and a validation case
-# through the whole command line, `mpirun -np N hgym-mpi validate` (scripts/mpi_check.sh). The
+# rsmpi's bindings) are installed if missing. Checks, 2 and 3 ranks against one process, bitwise
+# (exit 1 if they differ): the 3D and 2D solvers alone (examples/mpi_split.rs), a 3D and a 2D
+# validation case through the whole command line, `mpirun -np N hgym-mpi validate`
+# (scripts/mpi_check.sh), and training on a 3D and a 2D environment (scripts/mpi_train_check.sh). The
 # default build needs none of this; `hgym-mpi` is built beside `hgym`, not over it.
 MPIRUN := mpirun --allow-run-as-root --oversubscribe --bind-to none
 MPI_SPLIT := $(CARGO_TARGET_DIR)/release/examples/mpi_split
@@ -104,7 +105,9 @@ mpi: build
 	$(MPIRUN) -np 2 $(MPI_SPLIT)
 	$(MPIRUN) -np 3 $(MPI_SPLIT)
 	HGYM=$(HGYM) HGYM_MPI=$(HGYM_MPI) MPIRUN="$(MPIRUN)" scripts/mpi_check.sh tests/cases/sphere_mpi.toml
+	HGYM=$(HGYM) HGYM_MPI=$(HGYM_MPI) MPIRUN="$(MPIRUN)" scripts/mpi_check.sh tests/cases/cylinder_mpi.toml
 	HGYM=$(HGYM) HGYM_MPI=$(HGYM_MPI) MPIRUN="$(MPIRUN)" scripts/mpi_train_check.sh tests/cases/mpi_train.toml
+	HGYM=$(HGYM) HGYM_MPI=$(HGYM_MPI) MPIRUN="$(MPIRUN)" scripts/mpi_train_check.sh tests/cases/mpi_train2d.toml Cylinder_2D_Re100
 
 roofline: build $(CARGO_TARGET_DIR)/stream_copy
 	HGYM=$(HGYM) C_COPY=$(CARGO_TARGET_DIR)/stream_copy scripts/roofline.sh

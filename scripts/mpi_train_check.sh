@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `make mpi`: training, evaluation and an open-loop run of a 3D environment in one process
+# `make mpi`: training, evaluation and an open-loop run of an environment (3D by default) in one process
 # (`hgym`) and on 2 MPI ranks (`hgym-mpi` under mpirun, the flow split over the ranks, the rest
 # run alike on every rank, files and output from rank 0 only). The trained policy, the curve's
 # returns and the evaluation report (its --json output, which rank 1 must not repeat) must be
@@ -7,7 +7,7 @@
 set -euo pipefail
 : "${HGYM:?path to hgym}" "${HGYM_MPI:?path to hgym-mpi}" "${MPIRUN:=mpirun --allow-run-as-root --oversubscribe --bind-to none}"
 config=${1:-tests/cases/mpi_train.toml}
-env=Cylinder_3D_Re200
+env=${2:-Cylinder_3D_Re200}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export HGYM_CACHE="$work/cache"
@@ -46,6 +46,11 @@ set +e
 $MPIRUN -np 2 "$HGYM_MPI" leaderboard >/dev/null 2>&1; code=$?
 set -e
 [ $code = 2 ] || fail "a command that does not run on ranks exits with $code, not 2"
+set +e
+err=$($MPIRUN -np 2 "$HGYM_MPI" train --env $env --algo td3 --threads 2 --steps 4 --out "$work/threads" 2>&1 >/dev/null); code=$?
+set -e
+[ $code = 2 ] || fail "two environments on two threads per rank exit with $code, not 2"
+echo "$err" | grep -q -- "--threads 1" || fail "the refusal of parallel environments does not name the fix: $err"
 echo "MPI train check: bad input and commands that do not run on ranks exit 2"
 ls "${TMPDIR:-/tmp}" | grep -q "^hgym-rank" && fail "a rank left its scratch folder in ${TMPDIR:-/tmp}"
 exit 0

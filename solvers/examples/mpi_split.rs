@@ -1,18 +1,22 @@
-//! The 3D solver over MPI ranks against one process, bitwise, and its speed.
+//! The 3D and 2D solvers over MPI ranks against one process, bitwise, and their speed.
 //!
 //! `mpirun -np 2 mpi_split` (built with `--features mpi`; `make mpi` builds and runs it): every
 //! rank steps its slab of a channel with an inlet, an outlet with an absorbing layer, free-slip
-//! sides and a spinning sphere; rank 0 also steps the whole box alone, and the forces of every
-//! step, probes and the mass must be bitwise equal (exit 1 otherwise). With `--bench N` it then
-//! times `N` steps of a 192 x 96 x 96 D3Q19 box split over the ranks and prints MLUPS and the
-//! bytes each rank exchanges per step.
+//! sides and a spinning sphere (3D), and of the same with a spinning cylinder (D2Q9); rank 0 also
+//! steps each whole grid alone, and the forces of every step, probes and the mass must be bitwise
+//! equal (exit 1 otherwise). With `--bench N` it then times `N` steps of a 192 x 96 x 96 D3Q19
+//! box and of a 2048 x 1024 D2Q9 grid split over the ranks and prints MLUPS and the bytes each
+//! rank exchanges per step.
 
 use std::process::ExitCode;
 use std::time::Instant;
 
+use std::sync::Arc;
+
 use hgym_solvers::comm::{Comm, MpiComm, Solo};
-use hgym_solvers::geometry::{Solid, Sphere};
+use hgym_solvers::geometry::{Circle, Shape, Solid, Sphere};
 use hgym_solvers::lbm::d3::{split_axis, D3Config, D3q19, Face, Faces, Lbm3, Sponge3};
+use hgym_solvers::lbm::{D2q9, D2q9Config, Edge, Side, Sides, Sponge};
 use mpi::traits::Communicator;
 
 fn channel(n: [usize; 3]) -> D3Config {
@@ -74,6 +78,59 @@ fn run(n: [usize; 3], steps: usize, comm: Box<dyn Comm>) -> Result<Run, String> 
     })
 }
 
+/// The 2D channel: inlet, outlet with an absorbing layer, free-slip sides, a spinning cylinder.
+fn run_2d([nx, ny]: [usize; 2], steps: usize, comm: Box<dyn Comm>) -> Result<Run, String> {
+    let u = 0.04;
+    let sides = Sides {
+        west: Side::Velocity {
+            profile: vec![[u as f32, 0.0]; ny],
+        },
+        east: Side::Outlet,
+        south: Side::FreeSlip,
+        north: Side::FreeSlip,
+    };
+    let mut cfg = D2q9Config::new(nx, ny, 0.56, sides);
+    cfg.smagorinsky = 0.1;
+    cfg.sponges = vec![Sponge {
+        edge: Edge::East,
+        width: nx / 4,
+        strength: 0.3,
+        rho: 1.0,
+        u: [u, 0.0],
+    }];
+    let center = [0.3 * nx as f64, 0.47 * ny as f64];
+    let cylinder: Arc<dyn Shape> = Arc::new(Circle {
+        center,
+        radius: 0.12 * ny as f64,
+    });
+    let mut s = D2q9::new_split(cfg, vec![cylinder], comm).map_err(|e| e.to_string())?;
+    s.set_wall_velocity(0, |wp| [-0.01 * (wp.position[1] - center[1]), 0.01 * (wp.position[0] - center[0])]);
+    s.init_with(|x, y| (1.0, u, 1e-3 * ((x as usize * 7 + y as usize * 3) % 5) as f64));
+    let mut forces = Vec::new();
+    let t0 = Instant::now();
+    for _ in 0..steps {
+        s.step().map_err(|e| e.to_string())?;
+        forces.extend(s.body_forces().iter().flat_map(|f| f.map(f64::to_bits)));
+    }
+    let seconds = t0.elapsed().as_secs_f64();
+    let points: Vec<[f64; 2]> = [[0.1, 0.2], [0.45, 0.5], [0.8, 0.3]]
+        .iter()
+        .map(|p| [p[0] * (nx - 1) as f64, p[1] * (ny - 1) as f64])
+        .collect();
+    let probes = s
+        .probes(&points)
+        .map_err(|e| e.to_string())?
+        .iter()
+        .flat_map(|p| p.map(f64::to_bits))
+        .collect();
+    Ok(Run {
+        forces,
+        probes,
+        mass: s.total_mass().to_bits(),
+        seconds,
+    })
+}
+
 fn main() -> ExitCode {
     let Some(universe) = mpi::initialize() else {
         eprintln!("MPI was already initialised");
@@ -90,32 +147,50 @@ fn main() -> ExitCode {
     }
 }
 
-/// The comparison on every rank (judged on rank 0), then the bench if asked for.
+/// Names what differs between one process's run and the split one.
+fn differences(one: &Run, split: &Run) -> Vec<&'static str> {
+    [
+        ("forces", one.forces != split.forces),
+        ("probes", one.probes != split.probes),
+        ("mass", one.mass != split.mass),
+    ]
+    .iter()
+    .filter(|d| d.1)
+    .map(|d| d.0)
+    .collect()
+}
+
+/// The comparisons on every rank (judged on rank 0), then the benches if asked for.
 fn check(rank: i32, size: usize) -> Result<bool, String> {
     let bench: Option<usize> = std::env::args().skip_while(|a| a != "--bench").nth(1).and_then(|v| v.parse().ok());
-    let n = [48, 20, 16];
     let steps = 40;
+    let n = [48, 20, 16];
     let split = run(n, steps, Box::new(MpiComm))?;
+    let n2 = [96, 41];
+    let split_2d = run_2d(n2, steps, Box::new(MpiComm))?;
     if rank == 0 {
         let one = run(n, steps, Box::new(Solo))?;
-        let differ: Vec<&str> = [
-            ("forces", one.forces != split.forces),
-            ("probes", one.probes != split.probes),
-            ("mass", one.mass != split.mass),
-        ]
-        .iter()
-        .filter(|d| d.1)
-        .map(|d| d.0)
-        .collect();
-        let axis = ["x", "y", "z"][split_axis(n)];
-        if !differ.is_empty() {
-            println!(
-                "{n:?} box split along {axis} over {size} ranks, {steps} steps: {} DIFFER from one process",
-                differ.join(", ")
-            );
+        let one_2d = run_2d(n2, steps, Box::new(Solo))?;
+        let grids = [
+            (
+                format!("{n:?} D3Q19 box split along {}", ["x", "y", "z"][split_axis(n)]),
+                differences(&one, &split),
+            ),
+            (format!("{n2:?} D2Q9 grid split along y"), differences(&one_2d, &split_2d)),
+        ];
+        for (grid, differ) in &grids {
+            if differ.is_empty() {
+                println!("{grid} over {size} ranks, {steps} steps: forces, probes and mass bitwise the same as one process");
+            } else {
+                println!(
+                    "{grid} over {size} ranks, {steps} steps: {} DIFFER from one process",
+                    differ.join(", ")
+                );
+            }
+        }
+        if grids.iter().any(|g| !g.1.is_empty()) {
             return Ok(false);
         }
-        println!("{n:?} box split along {axis} over {size} ranks, {steps} steps: forces, probes and mass bitwise the same as one process");
     }
 
     if let Some(steps) = bench {
@@ -135,6 +210,22 @@ fn check(rank: i32, size: usize) -> Result<bool, String> {
                 (2 * (size - 1) * layer_bytes) as f64 / 1e6,
                 size - 1,
                 layer_bytes as f64 / 1e6
+            );
+        }
+        let n2 = [2048, 1024];
+        let r = run_2d(n2, steps, Box::new(MpiComm))?;
+        if rank == 0 {
+            let cells = n2[0] * n2[1];
+            let row_bytes = 9 * 4 * n2[0];
+            println!(
+                "bench {n2:?} D2Q9, {size} rank(s) x {} thread(s): {steps} steps in {:.2} s, {:.1} MLUPS; \
+                 {:.3} MB sent per step in all ({} boundaries, one {:.3} MB row each way)",
+                rayon::current_num_threads(),
+                r.seconds,
+                cells as f64 * steps as f64 / r.seconds / 1e6,
+                (2 * (size - 1) * row_bytes) as f64 / 1e6,
+                size - 1,
+                row_bytes as f64 / 1e6
             );
         }
     }

@@ -262,6 +262,25 @@ fn train_error(e: TrainError) -> anyhow::Error {
     }
 }
 
+/// Under MPI every split flow talks to the other ranks in the order its steps are taken, and
+/// environments stepped on several threads at once would take them in a different order on each
+/// rank: a learner with several environments runs on ranks only with one thread each.
+fn refuse_parallel_envs_on_ranks(opts: &TrainOptions, threads: usize) -> Result<()> {
+    let ranks = hgym::flow::ranks::rank().1;
+    let algo = algorithm(&opts.algo).map_err(|e| UsageError(e.to_string()))?;
+    let n_envs = algo.n_envs(&opts.config.algos).map_err(|e| UsageError(e.to_string()))?;
+    if ranks > 1 && threads > 1 && n_envs > 1 {
+        return Err(UsageError(format!(
+            "on {ranks} MPI ranks the {n_envs} training environments of {} would step their split flows on {threads} threads \
+             at once; run with --threads 1 (one rank per core) or set n_envs = 1 in the learner's section of --config \
+             (e.g. [td3])",
+            opts.algo
+        ))
+        .into());
+    }
+    Ok(())
+}
+
 pub fn run_train(args: TrainArgs) -> Result<Outcome> {
     let mut config = load_config(args.config.as_deref())?;
     if let Some(s) = args.steps {
@@ -271,7 +290,7 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
         print!("{}", config.to_toml());
         return Ok(Outcome::Ok);
     }
-    let (pool, _) = thread_pool(args.threads)?;
+    let (pool, threads) = thread_pool(args.threads)?;
     install_interrupt();
     let cache = hgym::env::default_cache_dir();
     let jobs: Vec<(TrainOptions, Option<hgym::train::checkpoint::Checkpoint>)> = if let Some(dir) = &args.resume {
@@ -344,6 +363,7 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
     };
     let mut finished = vec![];
     for (opts, ck) in jobs {
+        refuse_parallel_envs_on_ranks(&opts, threads)?;
         let label = format!("{} s{}", opts.algo, opts.seed);
         let pb = progress_bar(opts.config.train.steps, &label);
         if let Some(ck) = &ck {

@@ -77,6 +77,12 @@ impl LbmEnv {
         let solver = setup.build(&plan).and_then(LbmFlow::into_uniform).map_err(flow_error)?;
         let thermal = match &spec.thermal {
             None => None,
+            Some(_) if solver.rank().1 > 1 => {
+                return Err(EnvError::InvalidSpec(format!(
+                    "{}: its temperature field runs on one process (it is not split over ranks); run it without mpirun",
+                    spec.id
+                )))
+            }
             Some(th) => {
                 let side = |s: &Side, edge: Edge| match (s, edge) {
                     (Side::Periodic, _) => ThermalSide::Periodic,
@@ -244,9 +250,11 @@ impl LbmEnv {
         physics.gust = None;
         physics.ramp = Default::default();
         let hash = physics.hash();
-        self.cache_dir
-            .as_ref()
-            .map(|d| d.join(format!("flow-{}-{}.f32", self.level.name(), &hash[..16])))
+        self.cache_dir.as_ref().map(|d| match self.solver.rank() {
+            (_, 1) => d.join(format!("flow-{}-{}.f32", self.level.name(), &hash[..16])),
+            // Under MPI each rank keeps its own slab.
+            (r, n) => d.join(format!("flow-{}-{}-rank{r}of{n}.f32", self.level.name(), &hash[..16])),
+        })
     }
 
     /// Makes sure `self.attractor` holds the developed flow: from the disk cache, or by spinning
@@ -254,9 +262,12 @@ impl LbmEnv {
     fn develop(&mut self) -> Result<(), EnvError> {
         if self.attractor.is_none() {
             let want = self.solver.populations().len() + self.thermal.as_ref().map_or(0, |t| t.populations().len());
-            self.attractor = match self.cache_file().and_then(|p| super::spin_up::load_state(&p, want)) {
-                Some(state) => Some(state),
-                None => Some(self.spin_up()?),
+            let cached = self.cache_file().and_then(|p| super::spin_up::load_state(&p, want));
+            // Under MPI the ranks spin up together unless every one of them has its slab cached.
+            self.attractor = if self.solver.all_ranks(cached.is_some()) {
+                cached
+            } else {
+                Some(self.spin_up()?)
             };
         }
         Ok(())
@@ -318,8 +329,8 @@ impl LbmEnv {
     /// Raw probe values (u, v, p per probe; units of U and rho U^2).
     pub fn raw_observation(&self) -> Result<Vec<f64>, EnvError> {
         let mut obs = Vec::with_capacity(self.spec.obs_dim());
-        for p in &self.spec.probes {
-            let [rho, ux, uy] = self.solver.probe(*p).map_err(backend)?;
+        let values = self.solver.probes(&self.spec.probes).map_err(backend)?;
+        for (p, [rho, ux, uy]) in self.spec.probes.iter().zip(values) {
             obs.push(self.units.velocity(ux));
             obs.push(self.units.velocity(uy));
             obs.push(self.units.pressure(rho));

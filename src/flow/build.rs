@@ -28,7 +28,8 @@ impl FlowSetup {
     /// Builds the solver at `plan` (from [`FlowSetup::plan`]): edges, inlet profile (its value at
     /// each row's centre `eta = (j + 1/2) / ny`), collision, subgrid viscosity, absorbing layers,
     /// the characteristic inlet, the bodies, and the refined patches if the plan has them. The
-    /// fluid is left at rest with unit density; callers set their initial state.
+    /// fluid is left at rest with unit density; callers set their initial state. Under MPI a
+    /// uniform grid is split over the ranks ([`super::ranks`]); a refined one runs whole on each.
     pub fn build(&self, plan: &FlowPlan) -> Result<LbmFlow, FlowError> {
         if self.span.is_some() {
             return Err(FlowError::Invalid {
@@ -53,7 +54,7 @@ impl FlowSetup {
         }
         let bodies = self.bodies.iter().map(|b| b.shape()).collect();
         let built = match &plan.refinement {
-            None => D2q9::new(cfg, bodies).map(|s| LbmFlow::Uniform(Box::new(s))),
+            None => D2q9::new_split(cfg, bodies, super::ranks::comm()).map(|s| LbmFlow::Uniform(Box::new(s))),
             Some(r) => Refined::new(cfg, &r.patches, bodies).map(LbmFlow::Refined),
         };
         built.map_err(|e| match e {

@@ -208,8 +208,13 @@ impl FlowSetup {
             Some(nz) => format!("{} x {} x {nz}", count(nx_f), count(ny_f)),
             None => format!("{} x {}", count(nx_f), count(ny_f)),
         };
-        // A 3D box is split over the MPI ranks (`flow::ranks`); a 2D grid runs whole on each.
-        let ranks = if nz.is_some() { super::ranks::rank().1 } else { 1 };
+        // A box or a uniform grid is split over the MPI ranks (`flow::ranks`); a refined 2D grid
+        // runs whole on each.
+        let ranks = if nz.is_some() || self.refinement.is_none() {
+            super::ranks::rank().1
+        } else {
+            1
+        };
         fits_in_memory(&cells, nx_f * ny_f * nz_f * bytes as f64, bytes, ranks, available_memory())?;
         let (nx, ny) = (nx_f.round() as usize, ny_f.round() as usize);
         if nx < 8 || ny < 8 {

@@ -1,9 +1,11 @@
 //! hgym over MPI ranks, the single-program way: `mpirun -np N hgym-mpi COMMAND` runs the same
-//! command on every rank. The 3D lattice-Boltzmann flows split their boxes over the ranks
-//! ([`hgym_solvers::lbm::d3::Lbm3::new_split`]); everything they report (forces, probes, slices,
-//! the blow-up scan) is summed over the ranks bitwise as one process would compute it, so every
-//! rank takes the same decisions (agents, seeds, episode ends) without talking about them. Only
-//! rank 0 prints and writes files. The 2D flows run whole on every rank.
+//! command on every rank. The lattice-Boltzmann flows split their grids over the ranks
+//! ([`hgym_solvers::lbm::d3::Lbm3::new_split`], [`hgym_solvers::lbm::D2q9::new_split`]);
+//! everything they report (forces, probes, fields, slices, the blow-up scan) is summed over the
+//! ranks bitwise as one process would compute it, so every rank takes the same decisions
+//! (agents, seeds, episode ends) without talking about them. Only rank 0 prints and writes
+//! files. What is not split runs whole on every rank: 2D grids with refined patches, the
+//! temperature fields, the spectral solvers.
 //!
 //! The binary that starts MPI is `hgym-mpi` (the `mpi` feature, `make mpi`); `hgym` is one
 //! process and needs no MPI library.
@@ -31,7 +33,7 @@ pub fn leader() -> bool {
     rank().0 == 0
 }
 
-/// The ranks a 3D solver splits its box over: all of them under MPI, this process otherwise.
+/// The ranks a solver splits its grid over: all of them under MPI, this process otherwise.
 pub fn comm() -> Box<dyn Comm> {
     #[cfg(feature = "mpi")]
     if rank().1 > 1 {

@@ -60,6 +60,10 @@ pub const BUNDLED: &[(&str, &str)] = &[
         include_str!("../../benchmarks/validation/cylinder3d_re3900.toml"),
     ),
     (
+        "pinball3d_re30.toml",
+        include_str!("../../benchmarks/validation/pinball3d_re30.toml"),
+    ),
+    (
         "pinball3d_re100.toml",
         include_str!("../../benchmarks/validation/pinball3d_re100.toml"),
     ),

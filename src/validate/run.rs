@@ -281,7 +281,8 @@ impl Solver {
         match self {
             Solver::Flat(s) => {
                 s.sync();
-                points.iter().map(|p| s.coarse().probe([p[0], p[1]]).map(|v| v[1])).collect()
+                let points: Vec<[f64; 2]> = points.iter().map(|p| [p[0], p[1]]).collect();
+                Ok(s.coarse().probes(&points)?.into_iter().map(|v| v[1]).collect())
             }
             Solver::Span(s) => Ok(s.probes(points)?.into_iter().map(|(_, v)| v[0]).collect()),
         }

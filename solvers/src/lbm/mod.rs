@@ -20,6 +20,7 @@ mod error;
 mod forces;
 mod kernel;
 pub mod lattice;
+mod part;
 pub(crate) mod probes;
 mod refine;
 mod solver;

@@ -5,31 +5,45 @@ use super::error::LbmError;
 use super::solver::D2q9;
 
 impl D2q9 {
-    /// `(rho, ux, uy)` in lattice units at physical point `p`.
+    /// `(rho, ux, uy)` in lattice units at physical point `p`. A collective on a split grid, as
+    /// [`Self::probes`].
     pub fn probe(&self, p: [f64; 2]) -> Result<[f64; 3], LbmError> {
+        Ok(self.probes(&[p])?[0])
+    }
+
+    /// [`Self::probe`] at every point of `ps`. On a split grid the rank owning a stencil's first
+    /// row interpolates (its ghost row holds the second) and the others add zeros, all points in
+    /// one sum over the ranks: exact, so every rank gets one process's bits.
+    pub fn probes(&self, ps: &[[f64; 2]]) -> Result<Vec<[f64; 3]>, LbmError> {
         let g = self.config().grid;
         let (nx, ny) = (self.nx(), self.ny());
-        let xi = (p[0] - g.origin[0]) / g.dx;
-        let eta = (p[1] - g.origin[1]) / g.dx;
-        if !(xi >= 0.0 && eta >= 0.0 && xi <= (nx - 1) as f64 && eta <= (ny - 1) as f64) {
-            let hi = g.position((nx - 1) as f64, (ny - 1) as f64);
-            return Err(LbmError::ProbeOutside {
-                x: p[0],
-                y: p[1],
-                xmin: g.origin[0],
-                xmax: hi[0],
-                ymin: g.origin[1],
-                ymax: hi[1],
-            });
+        let mut out = vec![[0.0f64; 3]; ps.len()];
+        for (p, o) in ps.iter().zip(out.iter_mut()) {
+            let xi = (p[0] - g.origin[0]) / g.dx;
+            let eta = (p[1] - g.origin[1]) / g.dx;
+            if !(xi >= 0.0 && eta >= 0.0 && xi <= (nx - 1) as f64 && eta <= (ny - 1) as f64) {
+                let hi = g.position((nx - 1) as f64, (ny - 1) as f64);
+                return Err(LbmError::ProbeOutside {
+                    x: p[0],
+                    y: p[1],
+                    xmin: g.origin[0],
+                    xmax: hi[0],
+                    ymin: g.origin[1],
+                    ymax: hi[1],
+                });
+            }
+            let stencil = bilinear(xi, eta, nx, ny);
+            if !self.owns_row(stencil[0].1) {
+                continue;
+            }
+            for (x, y, w) in stencil {
+                let (rho, ux, uy) = if self.is_solid(x, y) { (1.0, 0.0, 0.0) } else { self.node(x, y) };
+                o[0] += w * rho as f64;
+                o[1] += w * ux as f64;
+                o[2] += w * uy as f64;
+            }
         }
-        let mut out = [0.0f64; 3];
-        for (x, y, w) in bilinear(xi, eta, nx, ny) {
-            let (rho, ux, uy) = if self.is_solid(x, y) { (1.0, 0.0, 0.0) } else { self.node(x, y) };
-            out[0] += w * rho as f64;
-            out[1] += w * ux as f64;
-            out[2] += w * uy as f64;
-        }
-        Ok(out)
+        Ok(self.sum_over_ranks(out))
     }
 }
 

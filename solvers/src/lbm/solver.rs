@@ -4,6 +4,8 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
+use crate::comm::{Comm, Solo};
+
 use super::aligned::AlignedVec;
 use super::boundary::InletReference;
 use super::check::{scan_row, RowStat};
@@ -13,6 +15,7 @@ use super::error::LbmError;
 use super::forces::link_forces;
 use super::kernel::{row_fn, KernelCtx, Link, Special};
 use super::lattice::{CX, CY, OPP, Q};
+use super::part::Part;
 use super::sponge::{apply_row, Sponge, SpongePlan};
 use crate::geometry::Shape;
 
@@ -94,9 +97,20 @@ pub struct WallPoint {
     pub body: usize,
 }
 
-/// D2Q9 lattice Boltzmann solver (see the module docs for the scheme).
+/// D2Q9 lattice Boltzmann solver (see the module docs for the scheme), on one process or on a
+/// rank's slab of the grid ([`D2q9::new_split`]).
 pub struct D2q9 {
+    /// This rank's grid: its slab and ghost rows (the whole grid on one process).
     cfg: D2q9Config,
+    /// The whole grid's configuration.
+    global: D2q9Config,
+    part: Part,
+    comm: Box<dyn Comm>,
+    /// The whole grid's solid nodes when split (`None`: `solid` is the whole grid's).
+    solid_global: Option<Vec<bool>>,
+    /// Force terms per (body, global row, axis), this rank's and summed over the ranks.
+    partial: Vec<f64>,
+    summed: Vec<f64>,
     relax: Relax,
     /// Current post-collision populations, shifted (`g = f - w`), row-blocked SoA.
     f: AlignedVec,
@@ -119,8 +133,10 @@ pub struct D2q9 {
 impl std::fmt::Debug for D2q9 {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("D2q9")
-            .field("nx", &self.cfg.nx)
-            .field("ny", &self.cfg.ny)
+            .field("nx", &self.global.nx)
+            .field("ny", &self.global.ny)
+            .field("rank", &self.comm.rank())
+            .field("ranks", &self.comm.size())
             .field("tau", &self.cfg.tau)
             .field("links", &self.links.len())
             .field("time", &self.time)
@@ -179,6 +195,15 @@ impl D2q9 {
     /// Plans the run: marks solid nodes, finds every link that crosses a wall with its Bouzidi
     /// fraction `q`, lists the nodes that need the general path, and initialises the rest state.
     pub fn new(cfg: D2q9Config, bodies: Vec<Arc<dyn Shape>>) -> Result<Self, LbmError> {
+        Self::new_split(cfg, bodies, Box::new(Solo))
+    }
+
+    /// This rank's slab of the grid `cfg` split over the ranks of `comm` along y (see
+    /// [`super::part`]): every rank calls this, and then every method below together. Each step
+    /// exchanges the ghost rows; forces, probes, mass, fields and the blow-up scan come out on
+    /// every rank bitwise as one process computes them. Node coordinates in arguments and errors
+    /// are the whole grid's. The characteristic inlet (a mean along its edge) is not split.
+    pub fn new_split(cfg: D2q9Config, bodies: Vec<Arc<dyn Shape>>, comm: Box<dyn Comm>) -> Result<Self, LbmError> {
         let (nx, ny) = (cfg.nx, cfg.ny);
         if nx < 3 || ny < 3 {
             return Err(config_error(
@@ -280,6 +305,15 @@ impl D2q9 {
         }
         let periodic_x = s.west == Side::Periodic;
         let periodic_y = s.south == Side::Periodic;
+        if comm.size() > 1 && cfg.characteristic_inlet.is_some() {
+            return Err(config_error(
+                "characteristic_inlet",
+                "the characteristic inlet averages the density along its edge on one process; \
+                 run without mpirun or with a rigid inlet (characteristic_time = 0)",
+            ));
+        }
+        let part =
+            Part::of([nx, ny, 1], [periodic_x, periodic_y, false], comm.rank(), comm.size()).map_err(|m| config_error("ranks", m))?;
         let grid = cfg.grid;
 
         // Solid nodes: inside a body, or on its wall (see `ON_WALL`).
@@ -305,7 +339,28 @@ impl D2q9 {
             return Err(config_error("bodies", "the bodies fill the whole domain; enlarge the domain"));
         }
 
-        // Links and the nodes that need the general path, row by row.
+        // This rank's grid: its rows and a ghost row (whose edge is a placeholder, filled by the
+        // exchange) towards each neighbour; a velocity edge's profile cut to the rows.
+        let global = cfg.clone();
+        let mut cfg = cfg;
+        let gy = |yl: usize| part.global_index(yl);
+        let nyl = part.local_n()[1];
+        cfg.ny = nyl;
+        if part.below.is_some() {
+            cfg.sides.south = Side::Wall;
+        }
+        if part.above.is_some() {
+            cfg.sides.north = Side::Wall;
+        }
+        for side in [&mut cfg.sides.west, &mut cfg.sides.east] {
+            if let Side::Velocity { profile } = side {
+                *profile = (0..nyl).map(|yl| profile[gy(yl)]).collect();
+            }
+        }
+        let local_periodic_y = cfg.sides.south == Side::Periodic;
+
+        // Links and the nodes that need the general path, row by row; a link is planned in the
+        // whole grid (wrapping, positions, the body it meets) and stored at this rank's node.
         let wrap = |v: isize, n: usize, periodic: bool| -> Option<usize> {
             if v >= 0 && (v as usize) < n {
                 Some(v as usize)
@@ -315,17 +370,19 @@ impl D2q9 {
                 None
             }
         };
-        let bulk_row = |y: usize| periodic_y || (y > 0 && y + 1 < ny);
+        let bulk_row = |yl: usize| local_periodic_y || (yl > 0 && yl + 1 < nyl);
         let mut specials = Vec::new();
         let mut links = Vec::new();
         let mut wall_points = Vec::new();
-        let mut row_start = Vec::with_capacity(ny + 1);
-        for y in 0..ny {
+        let mut row_start = Vec::with_capacity(nyl + 1);
+        for yl in 0..nyl {
             row_start.push(specials.len() as u32);
+            let y = gy(yl);
+            // A ghost row is not stepped (the exchange fills it) and has no links.
+            let ghost = !part.owns([0, yl, 0]);
             for x in 0..nx {
-                let cell = y * nx + x;
-                let edge = x == 0 || x + 1 == nx || !bulk_row(y);
-                if solid[cell] {
+                let edge = x == 0 || x + 1 == nx || !bulk_row(yl);
+                if ghost || solid[y * nx + x] {
                     specials.push(Special {
                         x: x as u32,
                         solid: true,
@@ -355,7 +412,7 @@ impl D2q9 {
                     let q = q.clamp(1e-3, 1.0);
                     let wp = [a[0] + q * (bpt[0] - a[0]), a[1] + q * (bpt[1] - a[1])];
                     links.push(Link {
-                        cell: cell as u32,
+                        cell: (yl * nx + x) as u32,
                         k: k as u8,
                         q: q as f32,
                         uw: [0.0, 0.0],
@@ -380,25 +437,36 @@ impl D2q9 {
         }
         row_start.push(specials.len() as u32);
 
+        let local_solid: Vec<bool> = (0..nyl)
+            .flat_map(|yl| solid[gy(yl) * nx..(gy(yl) + 1) * nx].iter().copied())
+            .collect();
+        let solid_global = part.is_split().then_some(solid);
         let relax = Relax::new(cfg.tau, cfg.smagorinsky);
         let n_bodies = bodies.len();
+        let sums = n_bodies * ny * 2;
         let mut solver = D2q9 {
             relax,
-            f: AlignedVec::zeros(nx * ny * Q),
-            f_next: AlignedVec::zeros(nx * ny * Q),
-            solid,
+            f: AlignedVec::zeros(nx * nyl * Q),
+            f_next: AlignedVec::zeros(nx * nyl * Q),
+            solid: local_solid,
+            solid_global,
             specials,
             row_start,
             links,
             wall_points,
             bodies,
             body_forces: vec![[0.0; 2]; n_bodies],
-            row_stats: vec![RowStat::default(); ny],
+            partial: vec![0.0; sums],
+            summed: vec![0.0; sums],
+            row_stats: vec![RowStat::default(); nyl],
             sponges: cfg.sponges.iter().map(SpongePlan::new).collect(),
             velocity_scale: 1.0,
             inlet_reference: cfg.characteristic_inlet.map(InletReference::new),
             time: 0,
             cfg,
+            global,
+            part,
+            comm,
         };
         solver.init_with(|_, _| (1.0, 0.0, 0.0));
         Ok(solver)
@@ -407,25 +475,31 @@ impl D2q9 {
     /// Sets every fluid node to the equilibrium of `(rho, ux, uy) = field(x, y)` (physical
     /// position, lattice density and velocity); solid nodes rest. Resets the time to zero.
     pub fn init_with(&mut self, mut field: impl FnMut(f64, f64) -> (f64, f64, f64)) {
-        let (nx, ny) = (self.cfg.nx, self.cfg.ny);
+        let (nx, ny, nyl) = (self.global.nx, self.global.ny, self.cfg.ny);
+        // Every node of the whole grid in order (a field may draw random numbers), kept on the
+        // rows this rank holds.
+        let rows: Vec<usize> = (0..nyl).map(|yl| self.part.global_index(yl)).collect();
         for y in 0..ny {
+            let held: Vec<usize> = (0..nyl).filter(|&yl| rows[yl] == y).collect();
             for x in 0..nx {
-                let e = if self.solid[y * nx + x] {
+                let e = if self.is_solid(x, y) {
                     [0.0; Q]
                 } else {
                     let p = self.cfg.grid.position(x as f64, y as f64);
                     let (rho, ux, uy) = field(p[0], p[1]);
                     equilibrium((rho - 1.0) as f32, ux as f32, uy as f32)
                 };
-                for (i, v) in e.iter().enumerate() {
-                    self.f[(y * Q + i) * nx + x] = *v;
+                for &yl in &held {
+                    for (i, v) in e.iter().enumerate() {
+                        self.f[(yl * Q + i) * nx + x] = *v;
+                    }
                 }
             }
         }
         self.f_next.copy_from_slice(&self.f);
         self.time = 0;
         if let Some(r) = &mut self.inlet_reference {
-            r.reset(&self.cfg.sides, &self.f, &self.solid, nx, ny);
+            r.reset(&self.cfg.sides, &self.f, &self.solid, nx, nyl);
         }
     }
 
@@ -436,7 +510,7 @@ impl D2q9 {
         }
     }
 
-    /// Advances one time step. Allocates nothing.
+    /// Advances one time step (every rank together). Allocates nothing.
     pub fn step(&mut self) -> Result<(), LbmError> {
         let ctx = kernel_ctx(
             &self.cfg,
@@ -453,22 +527,28 @@ impl D2q9 {
         let forced = self.cfg.body_force != [0.0, 0.0];
         let rows = self.f_next.par_chunks_mut(row_len).enumerate().with_min_len(4);
         let kernel = row_fn(self.cfg.collision, forced, self.cfg.smagorinsky > 0.0, false);
-        let (nx, ny, sponges, solid) = (self.cfg.nx, self.cfg.ny, &self.sponges, &self.solid);
+        let (nx, ny, sponges, solid, part) = (self.cfg.nx, self.global.ny, &self.sponges, &self.solid, &self.part);
         rows.for_each(|(y, row)| {
             kernel(&ctx, src, row, y);
-            apply_row(sponges, row, y, nx, ny, solid);
+            if part.owns([0, y, 0]) {
+                apply_row(sponges, row, part.global_index(y), nx, ny, &solid[y * nx..(y + 1) * nx]);
+            }
         });
-        link_forces(&ctx, src, &mut self.body_forces);
+        link_forces(&ctx, src, |y| part.global_index(y), ny, &mut self.partial);
+        self.finish_step()
+    }
+
+    /// The rest of a step after the kernel: the ghost rows, the forces summed over the ranks,
+    /// the characteristic inlet, and the blow-up checks.
+    fn finish_step(&mut self) -> Result<(), LbmError> {
         std::mem::swap(&mut self.f, &mut self.f_next);
+        self.exchange();
         self.time += 1;
         self.update_inlet_reference();
-
+        self.total_forces();
         for (b, force) in self.body_forces.iter().enumerate() {
             if !force[0].is_finite() || !force[1].is_finite() {
-                let l = self.links.iter().find(|l| l.body as usize == b);
-                let (x, y) = l
-                    .map(|l| (l.cell as usize % self.cfg.nx, l.cell as usize / self.cfg.nx))
-                    .unwrap_or((0, 0));
+                let (x, y) = self.first_link_of(b);
                 return Err(LbmError::Diverged {
                     step: self.time,
                     reason: format!("the force on body {b} is not finite"),
@@ -491,44 +571,71 @@ impl D2q9 {
         Ok(())
     }
 
-    /// Scans every node for NaN, density out of `rho_bounds` or speed above `u_max`.
+    /// Scans every node for NaN, density out of `rho_bounds` or speed above `u_max`; reports the
+    /// first bad node in row order (the same on every rank).
     pub fn check(&mut self) -> Result<(), LbmError> {
-        let (nx, f, solid) = (self.cfg.nx, &self.f, &self.solid);
-        self.row_stats
-            .par_iter_mut()
-            .enumerate()
-            .for_each(|(y, st)| *st = scan_row(f, solid, nx, y));
+        let (nx, f, solid, part) = (self.cfg.nx, &self.f, &self.solid, &self.part);
+        self.row_stats.par_iter_mut().enumerate().for_each(|(y, st)| {
+            *st = if part.owns([0, y, 0]) {
+                scan_row(f, solid, nx, y)
+            } else {
+                RowStat::default()
+            };
+        });
         let [rho_lo, rho_hi] = self.cfg.rho_bounds;
         let u2_max = self.cfg.u_max * self.cfg.u_max;
-        for (y, st) in self.row_stats.iter().enumerate() {
-            let diverged = |reason: String, x: usize| LbmError::Diverged {
-                step: self.time,
-                reason,
-                x,
-                y,
-            };
-            if let Some(x) = st.nan_at {
-                return Err(diverged("NaN in the populations".into(), x));
+        // This rank's first bad node: (global row, x, what, value), `what` 1-4 as below.
+        let bad = self
+            .row_stats
+            .iter()
+            .enumerate()
+            .filter(|(y, _)| part.owns([0, *y, 0]))
+            .find_map(|(y, st)| {
+                let y = part.global_index(y) as f64;
+                if let Some(x) = st.nan_at {
+                    Some([y, x as f64, 1.0, 0.0])
+                } else if st.rho_min.0 < rho_lo {
+                    Some([y, st.rho_min.1 as f64, 2.0, st.rho_min.0 as f64])
+                } else if st.rho_max.0 > rho_hi {
+                    Some([y, st.rho_max.1 as f64, 3.0, st.rho_max.0 as f64])
+                } else if st.u2_max.0 > u2_max {
+                    Some([y, st.u2_max.1 as f64, 4.0, st.u2_max.0.sqrt() as f64])
+                } else {
+                    None
+                }
+            });
+        // Every rank's first, in rank slots: the lowest rank's comes first in row order.
+        let first = if self.comm.size() == 1 {
+            bad
+        } else {
+            let (rank, size) = (self.comm.rank(), self.comm.size());
+            let mut mine = vec![0.0f64; 5 * size];
+            if let Some(b) = bad {
+                mine[5 * rank] = 1.0;
+                mine[5 * rank + 1..5 * rank + 5].copy_from_slice(&b);
             }
-            if st.rho_min.0 < rho_lo {
-                return Err(diverged(format!("density {:.4} below {rho_lo}", st.rho_min.0), st.rho_min.1));
-            }
-            if st.rho_max.0 > rho_hi {
-                return Err(diverged(format!("density {:.4} above {rho_hi}", st.rho_max.0), st.rho_max.1));
-            }
-            if st.u2_max.0 > u2_max {
-                return Err(diverged(
-                    format!(
-                        "lattice speed {:.4} above {} (Mach {:.2})",
-                        st.u2_max.0.sqrt(),
-                        self.cfg.u_max,
-                        st.u2_max.0.sqrt() * 3f32.sqrt()
-                    ),
-                    st.u2_max.1,
-                ));
-            }
-        }
-        Ok(())
+            let mut all = vec![0.0f64; 5 * size];
+            self.comm.sum(&mine, &mut all);
+            all.chunks(5).find(|c| c[0] == 1.0).map(|c| [c[1], c[2], c[3], c[4]])
+        };
+        let Some([y, x, what, value]) = first else { return Ok(()) };
+        let value = value as f32;
+        let reason = match what as u8 {
+            1 => "NaN in the populations".to_string(),
+            2 => format!("density {value:.4} below {rho_lo}"),
+            3 => format!("density {value:.4} above {rho_hi}"),
+            _ => format!(
+                "lattice speed {value:.4} above {} (Mach {:.2})",
+                self.cfg.u_max,
+                value * 3f32.sqrt()
+            ),
+        };
+        Err(LbmError::Diverged {
+            step: self.time,
+            reason,
+            x: x as usize,
+            y: y as usize,
+        })
     }
 
     /// Multiplies every [`Side::Velocity`] profile by `scale` from the next step on (inlet ramps).
@@ -542,9 +649,13 @@ impl D2q9 {
         if !(u[0].is_finite() && u[1].is_finite()) {
             return Err(config_error("sides", format!("the {} velocity {u:?} is not finite", edge.name())));
         }
-        match self.cfg.sides.get_mut(edge) {
+        match self.global.sides.get_mut(edge) {
             Side::Velocity { profile } => {
                 profile.fill([u[0] as f32, u[1] as f32]);
+                // This rank's copy: the same edge (a velocity edge is never a ghost's placeholder).
+                if let Side::Velocity { profile } = self.cfg.sides.get_mut(edge) {
+                    profile.fill([u[0] as f32, u[1] as f32]);
+                }
                 Ok(())
             }
             other => Err(config_error(
@@ -571,17 +682,17 @@ impl D2q9 {
     /// `q >= 1/2`), with `rho_w = 1`. Zero for a resting wall; zero to round-off for a
     /// zero-net-mass-flux jet pair.
     pub fn wall_mass_source(&self, body: usize) -> f64 {
-        let mut m = 0.0f64;
-        for l in self.links.iter().filter(|l| l.body as usize == body) {
+        let nx = self.cfg.nx;
+        let terms = self.links.iter().filter(|l| l.body as usize == body).map(|l| {
             let k = l.k as usize;
             let cu = CX[k] as f64 * l.uw[0] as f64 + CY[k] as f64 * l.uw[1] as f64;
             let term = 6.0 * super::lattice::W[k] as f64 * cu;
-            m += if l.q < 0.5 { term } else { term / (2.0 * l.q as f64) };
-        }
-        m
+            (l.cell as usize / nx, if l.q < 0.5 { term } else { term / (2.0 * l.q as f64) })
+        });
+        self.split_sum(terms)
     }
 
-    /// The wall points (one per link) of every body.
+    /// The wall points (one per link) of every body, this rank's links.
     pub fn wall_points(&self) -> &[WallPoint] {
         &self.wall_points
     }
@@ -601,30 +712,69 @@ impl D2q9 {
         self.time
     }
 
+    /// Nodes along x of the whole grid.
     pub fn nx(&self) -> usize {
-        self.cfg.nx
+        self.global.nx
     }
 
+    /// Nodes along y of the whole grid.
     pub fn ny(&self) -> usize {
-        self.cfg.ny
+        self.global.ny
     }
 
+    /// The whole grid's configuration.
     pub fn config(&self) -> &D2q9Config {
-        &self.cfg
+        &self.global
     }
 
+    /// `(rank, ranks)` of the group the grid is split over; `(0, 1)` on one process.
+    pub fn rank(&self) -> (usize, usize) {
+        (self.comm.rank(), self.comm.size())
+    }
+
+    /// Whether `yes` holds on every rank (a collective: every rank calls it).
+    pub fn all_ranks(&self, yes: bool) -> bool {
+        let mut count = [0.0];
+        self.comm.sum(&[f64::from(u8::from(yes))], &mut count);
+        count[0] == self.comm.size() as f64
+    }
+
+    /// Whether node `(x, y)` of the whole grid is solid.
     pub fn is_solid(&self, x: usize, y: usize) -> bool {
-        self.solid[y * self.cfg.nx + x]
+        self.solid_global.as_ref().unwrap_or(&self.solid)[y * self.global.nx + x]
     }
 
-    /// Number of fluid nodes.
+    /// Number of fluid nodes of the whole grid.
     pub fn fluid_nodes(&self) -> usize {
-        self.solid.iter().filter(|s| !**s).count()
+        self.solid_global.as_ref().unwrap_or(&self.solid).iter().filter(|s| !**s).count()
     }
 
-    /// Density and velocity of node `(x, y)` (lattice units).
+    /// Whether this rank owns row `y` of the whole grid (every row, on one process).
+    pub(crate) fn owns_row(&self, y: usize) -> bool {
+        self.local_row(y).is_some_and(|yl| self.part.owns([0, yl, 0]))
+    }
+
+    /// Triples summed over the ranks (each held by one rank, zeros elsewhere: exact).
+    pub(crate) fn sum_over_ranks(&self, v: Vec<[f64; 3]>) -> Vec<[f64; 3]> {
+        if !self.part.is_split() {
+            return v;
+        }
+        let flat: Vec<f64> = v.iter().flatten().copied().collect();
+        let mut all = vec![0.0; flat.len()];
+        self.comm.sum(&flat, &mut all);
+        all.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
+    }
+
+    /// This rank's row of row `y` of the whole grid, if it holds it (owned or ghost).
+    fn local_row(&self, y: usize) -> Option<usize> {
+        self.part.local([0, y, 0]).map(|p| p[1])
+    }
+
+    /// Density and velocity of node `(x, y)` of the whole grid (lattice units); on a split grid
+    /// the node must be on this rank's rows (owned or ghost).
     pub fn node(&self, x: usize, y: usize) -> (f32, f32, f32) {
         let nx = self.cfg.nx;
+        let y = self.local_row(y).expect("node: a row this rank does not hold");
         let mut g = [0.0f32; Q];
         for (i, gi) in g.iter_mut().enumerate() {
             *gi = self.f[(y * Q + i) * nx + x];
@@ -633,7 +783,11 @@ impl D2q9 {
     }
 
     /// The nine shifted post-collision populations `g_i = f_i* - w_i` of node `(x, y)`.
+    ///
+    /// This and the three methods after it couple nested grids, which run on one process: on a
+    /// split grid they would address this rank's rows, and they are refused there.
     pub fn node_populations(&self, x: usize, y: usize) -> [f32; Q] {
+        assert!(!self.part.is_split(), "grid coupling on a split grid");
         let nx = self.cfg.nx;
         std::array::from_fn(|i| self.f[(y * Q + i) * nx + x])
     }
@@ -641,6 +795,7 @@ impl D2q9 {
     /// Overwrites the shifted post-collision populations of node `(x, y)` (grid coupling: the
     /// next step streams them like any other node's). Allocates nothing.
     pub fn set_node_populations(&mut self, x: usize, y: usize, g: &[f32; Q]) {
+        assert!(!self.part.is_split(), "grid coupling on a split grid");
         let nx = self.cfg.nx;
         for (i, v) in g.iter().enumerate() {
             self.f[(y * Q + i) * nx + x] = *v;
@@ -653,6 +808,7 @@ impl D2q9 {
     /// A row's new values must depend on its position and the inputs alone, so the result is
     /// the same for any thread count. Allocates nothing.
     pub fn rewrite_rows(&mut self, ys: std::ops::Range<usize>, rewrite: impl Fn(usize, &[bool], &mut [f32]) + Sync) {
+        assert!(!self.part.is_split(), "grid coupling on a split grid");
         let nx = self.cfg.nx;
         let (solid, y0, ny) = (&self.solid, ys.start, ys.len());
         self.f.par_chunks_mut(Q * nx).skip(y0).take(ny).enumerate().for_each(|(k, row)| {
@@ -663,6 +819,7 @@ impl D2q9 {
 
     /// Row `y`'s solid flags (`[x]`) and shifted post-collision populations (`[i * nx + x]`).
     pub fn row(&self, y: usize) -> (&[bool], &[f32]) {
+        assert!(!self.part.is_split(), "grid coupling on a split grid");
         let nx = self.cfg.nx;
         (&self.solid[y * nx..(y + 1) * nx], &self.f[y * Q * nx..(y + 1) * Q * nx])
     }
@@ -676,41 +833,124 @@ impl D2q9 {
         (rho, (jx + 0.5 * fx) / rho, (jy + 0.5 * fy) / rho)
     }
 
-    /// Fills density and velocity fields (row-major `y * nx + x`, lattice units).
-    /// Rows run in parallel (each node is independent: the same result for any thread count).
+    /// Fills density and velocity fields of the whole grid (row-major `y * nx + x`, lattice
+    /// units). Rows run in parallel (each node is independent: the same result for any thread
+    /// count); on a split grid each rank fills its rows and the fields are summed over the ranks
+    /// (exact: every value comes from one rank).
     pub fn macroscopic(&self, rho: &mut [f32], ux: &mut [f32], uy: &mut [f32]) {
         let nx = self.cfg.nx;
+        let part = &self.part;
         rho.par_chunks_mut(nx)
             .zip(ux.par_chunks_mut(nx))
             .zip(uy.par_chunks_mut(nx))
-            .take(self.cfg.ny)
+            .take(self.global.ny)
             .enumerate()
             .for_each(|(y, ((r, u), v))| {
-                // Row `y` holds the nine direction rows one after another.
-                let rows = &self.f[y * Q * nx..(y + 1) * Q * nx];
+                let held = self.local_row(y).filter(|&yl| part.owns([0, yl, 0]));
+                let Some(yl) = held else {
+                    r.fill(0.0);
+                    u.fill(0.0);
+                    v.fill(0.0);
+                    return;
+                };
+                // Row `yl` holds the nine direction rows one after another.
+                let rows = &self.f[yl * Q * nx..(yl + 1) * Q * nx];
                 for x in 0..nx.min(r.len()) {
                     let g: [f32; Q] = std::array::from_fn(|i| rows[i * nx + x]);
                     (r[x], u[x], v[x]) = self.density_velocity(&g);
                 }
             });
-    }
-
-    /// Total mass `sum rho` over fluid nodes, in f64.
-    pub fn total_mass(&self) -> f64 {
-        let nx = self.cfg.nx;
-        let mut m = 0.0f64;
-        for y in 0..self.cfg.ny {
-            for x in 0..nx {
-                if !self.solid[y * nx + x] {
-                    let mut s = 1.0f64;
-                    for i in 0..Q {
-                        s += self.f[(y * Q + i) * nx + x] as f64;
-                    }
-                    m += s;
-                }
+        if self.part.is_split() {
+            for field in [rho, ux, uy] {
+                let mine: Vec<f64> = field.iter().map(|&v| v as f64).collect();
+                let mut all = vec![0.0; mine.len()];
+                self.comm.sum(&mine, &mut all);
+                field.iter_mut().zip(&all).for_each(|(v, a)| *v = *a as f32);
             }
         }
-        m
+    }
+
+    /// Total mass `sum rho` over fluid nodes, in f64: per row in node order, then over the rows
+    /// in order (every rank gets the same bits).
+    pub fn total_mass(&self) -> f64 {
+        let nx = self.cfg.nx;
+        let fluid = (0..self.cfg.ny)
+            .filter(|&y| self.part.owns([0, y, 0]))
+            .flat_map(|y| (0..nx).map(move |x| (x, y)))
+            .filter(|&(x, y)| !self.solid[y * nx + x]);
+        self.split_sum(fluid.map(|(x, y)| (y, 1.0 + (0..Q).map(|i| self.f[(y * Q + i) * nx + x] as f64).sum::<f64>())))
+    }
+
+    /// The sum of `terms` (this rank's row, value), bitwise the same on any number of ranks: per
+    /// row of the whole grid first, then in row order (see [`super::part`]).
+    fn split_sum(&self, terms: impl Iterator<Item = (usize, f64)>) -> f64 {
+        let mut per_row = vec![0.0f64; self.global.ny];
+        for (y, v) in terms {
+            per_row[self.part.global_index(y)] += v;
+        }
+        let mut summed = vec![0.0; per_row.len()];
+        self.comm.sum(&per_row, &mut summed);
+        summed.iter().sum()
+    }
+
+    /// The forces of the last step: the per-row terms summed over the ranks, then over the rows
+    /// in order, per body.
+    fn total_forces(&mut self) {
+        self.comm.sum(&self.partial, &mut self.summed);
+        for (f, rows) in self.body_forces.iter_mut().zip(self.summed.chunks(2 * self.global.ny)) {
+            *f = [0.0; 2];
+            for v in rows.chunks(2) {
+                f[0] += v[0];
+                f[1] += v[1];
+            }
+        }
+    }
+
+    /// The first link of body `b` in the whole grid's order (where a non-finite force is reported).
+    fn first_link_of(&self, b: usize) -> (usize, usize) {
+        let nx = self.cfg.nx;
+        let mine = self.links.iter().find(|l| l.body as usize == b).map(|l| {
+            let y = l.cell as usize / nx;
+            (l.cell as usize % nx, self.part.global_index(y))
+        });
+        if self.comm.size() == 1 {
+            return mine.unwrap_or((0, 0));
+        }
+        let (rank, size) = (self.comm.rank(), self.comm.size());
+        let mut slots = vec![0.0f64; 3 * size];
+        if let Some((x, y)) = mine {
+            slots[3 * rank..3 * rank + 3].copy_from_slice(&[1.0, x as f64, y as f64]);
+        }
+        let mut all = vec![0.0; slots.len()];
+        self.comm.sum(&slots, &mut all);
+        all.chunks(3)
+            .find(|c| c[0] == 1.0)
+            .map_or((0, 0), |c| (c[1] as usize, c[2] as usize))
+    }
+
+    /// Sends the owned rows next to each neighbour into its ghost row and fills this rank's
+    /// ghosts from them: up, then down. Rows are contiguous, so they go as they lie. Allocates
+    /// nothing.
+    fn exchange(&mut self) {
+        if !self.part.is_split() {
+            return;
+        }
+        let len = Q * self.cfg.nx;
+        let (own, last) = (self.part.own.clone(), self.cfg.ny - 1);
+        // Up: the last owned row to the rank above, into ghost 0 from the rank below; then down.
+        let passes = [
+            (own.end - 1, self.part.above, 0, self.part.below),
+            (own.start, self.part.below, last, self.part.above),
+        ];
+        for (send, to, recv, from) in passes {
+            let (lo, hi) = self.f.split_at_mut(send.max(recv) * len);
+            let (send_row, recv_row) = if send < recv {
+                (&lo[send * len..][..len], &mut hi[..len])
+            } else {
+                (&hi[..len], &mut lo[recv * len..][..len])
+            };
+            self.comm.shift(to.map(|r| (send_row, r)), from.map(|r| (recv_row, r)));
+        }
     }
 
     /// Raw shifted populations (row-blocked SoA, see the crate docs); for tests and checkpoints.
@@ -748,15 +988,15 @@ impl D2q9 {
         let forced = self.cfg.body_force != [0.0, 0.0];
         let row_len = Q * self.cfg.nx;
         let kernel = row_fn(self.cfg.collision, forced, self.cfg.smagorinsky > 0.0, true);
+        let (nx, ny, part) = (self.cfg.nx, self.global.ny, &self.part);
         for (y, row) in self.f_next.chunks_mut(row_len).enumerate() {
             kernel(&ctx, &self.f, row, y);
-            apply_row(&self.sponges, row, y, self.cfg.nx, self.cfg.ny, &self.solid);
+            if part.owns([0, y, 0]) {
+                apply_row(&self.sponges, row, part.global_index(y), nx, ny, &self.solid[y * nx..(y + 1) * nx]);
+            }
         }
-        link_forces(&ctx, &self.f, &mut self.body_forces);
-        std::mem::swap(&mut self.f, &mut self.f_next);
-        self.time += 1;
-        self.update_inlet_reference();
-        Ok(())
+        link_forces(&ctx, &self.f, |y| part.global_index(y), ny, &mut self.partial);
+        self.finish_step()
     }
 
     /// Fills the spare array with NaN (tests: results must not depend on its contents).

@@ -76,8 +76,10 @@ impl SpongePlan {
 }
 
 /// Applies every layer to one row of post-collision populations (row-blocked SoA:
-/// `row[i * nx + x]`). Solid nodes are left alone. Allocates nothing.
-pub(crate) fn apply_row(plans: &[SpongePlan], row: &mut [f32], y: usize, nx: usize, ny: usize, solid: &[bool]) {
+/// `row[i * nx + x]`) at row `y` of a grid `nx` by `ny` (the whole grid's, when this is a
+/// rank's slab); `solid_row[x]` marks the row's solid nodes, which are left alone. Allocates
+/// nothing.
+pub(crate) fn apply_row(plans: &[SpongePlan], row: &mut [f32], y: usize, nx: usize, ny: usize, solid_row: &[bool]) {
     for p in plans.iter().filter(|p| p.touches_row(y, ny)) {
         let xs = match p.edge {
             Edge::West => 0..p.width.min(nx),
@@ -86,7 +88,7 @@ pub(crate) fn apply_row(plans: &[SpongePlan], row: &mut [f32], y: usize, nx: usi
         };
         for x in xs {
             let s = p.sigma(x, y, nx, ny);
-            if s == 0.0 || solid[y * nx + x] {
+            if s == 0.0 || solid_row[x] {
                 continue;
             }
             for (i, e) in p.g_eq.iter().enumerate() {
@@ -141,7 +143,7 @@ mod tests {
                 row[i * nx + x] = if x == 0 { p.g_eq[i] } else { p.g_eq[i] + 0.01 };
             }
         }
-        apply_row(std::slice::from_ref(&p), &mut row, ny - 1, nx, ny, &[false; 36]);
+        apply_row(std::slice::from_ref(&p), &mut row, ny - 1, nx, ny, &[false; 6]);
         for i in 0..Q {
             assert_eq!(row[i * nx], p.g_eq[i]);
             assert!((row[i * nx + 1] - p.g_eq[i] - 0.005).abs() < 1e-7);

@@ -20,14 +20,13 @@
 mod collision;
 mod kernel;
 pub mod lattice;
-mod part;
 mod sides;
 mod solver;
 mod sponge;
 pub mod thermal;
 
+pub use super::part::split_axis;
 pub use lattice::{D3q19, D3q27, Lattice3};
-pub use part::split_axis;
 pub use sides::{Face, Faces};
 pub use solver::{D3Config, Grid3, Lbm3};
 pub use sponge::Sponge3;

@@ -10,11 +10,11 @@ use super::super::solver::STREAM_STORES_ABOVE_BYTES;
 use super::collision::{collide, equilibrium, moments};
 use super::kernel::{bouzidi, gather, index, plan_pulls, plane, Ctx, FaceMoments, FacePull, Link, Special, PAD};
 use super::lattice::Lattice3;
-use super::part::Part;
 use super::sides::{Face, Faces};
 use super::sponge::{apply_plane, Layers, Sponge3, Sponge3Plan};
 use crate::comm::{Comm, Solo};
 use crate::geometry::Solid;
+use crate::lbm::part::Part;
 
 /// Where node `(i, j, k)` sits in physical space: `origin + (i, j, k) dx`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -8,7 +8,7 @@ use std::ops::Range;
 
 use super::collision::{equilibrium, CHUNK};
 use super::lattice::Lattice3;
-use super::part::Part;
+use crate::lbm::part::Part;
 
 /// One absorbing layer.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,11 +1,12 @@
-//! One process's share of the 3D box when the solver is split over ranks: a slab along the
-//! longer of y and z, with one ghost layer on each side that has a neighbouring rank. Not along
-//! x, even where x is the longest axis: x is the kernel's row, and slabs of it leave rows whose
-//! length is not a multiple of 8, so the kernel loses its non-temporal stores (the sphere at
-//! 160 x 96 x 96 on two ranks: 51 MLUPS split along x, against 70 for one process); the faces
-//! between slabs are larger (y z against x z), which the exchange pays once per step. A rank plans and steps its slab and ghosts as a box of its
-//! own; after each step the layers next to its neighbours are sent into their ghosts, so every
-//! owned node pulls exactly what it would pull in the whole box.
+//! One process's share of the grid when a solver is split over ranks: a slab along the
+//! longer of y and z (a 2D grid is a box one node thick in z, so it is split along y), with one
+//! ghost layer on each side that has a neighbouring rank. Not along x, even where x is the
+//! longest axis: x is the kernels' row, and slabs of it leave rows whose length is not a
+//! multiple of 8, so the kernel loses its non-temporal stores (the sphere at 160 x 96 x 96 on
+//! two ranks: 51 MLUPS split along x, against 70 for one process); the faces between slabs are
+//! larger (y z against x z), which the exchange pays once per step. A rank plans and steps its
+//! slab and ghosts as a grid of its own; after each step the layers next to its neighbours are
+//! sent into their ghosts, so every owned node pulls exactly what it would pull in the whole grid.
 //!
 //! Sums that must come out bitwise the same on any number of ranks (forces, mass) are taken per
 //! index along the split axis first, each index held by one rank, and then added in index order;
