@@ -19,6 +19,30 @@ pub trait Comm: Send + Sync {
     fn shift(&self, send: Option<(&[f32], usize)>, recv: Option<(&mut [f32], usize)>);
     /// `out` becomes the element-wise sum over ranks of `v`, on every rank (same lengths).
     fn sum(&self, v: &[f64], out: &mut [f64]);
+
+    /// Whether `yes` holds on every rank.
+    fn all(&self, yes: bool) -> bool {
+        let mut count = [0.0];
+        self.sum(&[f64::from(u8::from(yes))], &mut count);
+        count[0] == self.size() as f64
+    }
+
+    /// The `width` values of the lowest rank that has any, on every rank: each rank's in slots of
+    /// its own in one sum (exact: every slot holds one rank's values).
+    fn lowest_rank(&self, mine: Option<&[f64]>, width: usize) -> Option<Vec<f64>> {
+        if self.size() == 1 {
+            return mine.map(<[f64]>::to_vec); // no allocation on the way that finds nothing
+        }
+        let (rank, w) = (self.rank(), width + 1);
+        let mut slots = vec![0.0; w * self.size()];
+        if let Some(v) = mine {
+            slots[w * rank] = 1.0;
+            slots[w * rank + 1..w * (rank + 1)].copy_from_slice(v);
+        }
+        let mut all = vec![0.0; slots.len()];
+        self.sum(&slots, &mut all);
+        all.chunks(w).find(|c| c[0] == 1.0).map(|c| c[1..].to_vec())
+    }
 }
 
 /// One process: nothing to exchange.

@@ -604,21 +604,11 @@ impl D2q9 {
                     None
                 }
             });
-        // Every rank's first, in rank slots: the lowest rank's comes first in row order.
-        let first = if self.comm.size() == 1 {
-            bad
-        } else {
-            let (rank, size) = (self.comm.rank(), self.comm.size());
-            let mut mine = vec![0.0f64; 5 * size];
-            if let Some(b) = bad {
-                mine[5 * rank] = 1.0;
-                mine[5 * rank + 1..5 * rank + 5].copy_from_slice(&b);
-            }
-            let mut all = vec![0.0f64; 5 * size];
-            self.comm.sum(&mine, &mut all);
-            all.chunks(5).find(|c| c[0] == 1.0).map(|c| [c[1], c[2], c[3], c[4]])
+        // The lowest rank's first comes first in row order.
+        let Some(first) = self.comm.lowest_rank(bad.as_ref().map(|b| &b[..]), 4) else {
+            return Ok(());
         };
-        let Some([y, x, what, value]) = first else { return Ok(()) };
+        let [y, x, what, value] = [first[0], first[1], first[2], first[3]];
         let value = value as f32;
         let reason = match what as u8 {
             1 => "NaN in the populations".to_string(),
@@ -734,9 +724,7 @@ impl D2q9 {
 
     /// Whether `yes` holds on every rank (a collective: every rank calls it).
     pub fn all_ranks(&self, yes: bool) -> bool {
-        let mut count = [0.0];
-        self.comm.sum(&[f64::from(u8::from(yes))], &mut count);
-        count[0] == self.comm.size() as f64
+        self.comm.all(yes)
     }
 
     /// Whether node `(x, y)` of the whole grid is solid.
@@ -911,21 +899,10 @@ impl D2q9 {
         let nx = self.cfg.nx;
         let mine = self.links.iter().find(|l| l.body as usize == b).map(|l| {
             let y = l.cell as usize / nx;
-            (l.cell as usize % nx, self.part.global_index(y))
+            [(l.cell as usize % nx) as f64, self.part.global_index(y) as f64]
         });
-        if self.comm.size() == 1 {
-            return mine.unwrap_or((0, 0));
-        }
-        let (rank, size) = (self.comm.rank(), self.comm.size());
-        let mut slots = vec![0.0f64; 3 * size];
-        if let Some((x, y)) = mine {
-            slots[3 * rank..3 * rank + 3].copy_from_slice(&[1.0, x as f64, y as f64]);
-        }
-        let mut all = vec![0.0; slots.len()];
-        self.comm.sum(&slots, &mut all);
-        all.chunks(3)
-            .find(|c| c[0] == 1.0)
-            .map_or((0, 0), |c| (c[1] as usize, c[2] as usize))
+        let first = self.comm.lowest_rank(mine.as_ref().map(|m| &m[..]), 2);
+        first.map_or((0, 0), |c| (c[0] as usize, c[1] as usize))
     }
 
     /// Sends the owned rows next to each neighbour into its ghost row and fills this rank's

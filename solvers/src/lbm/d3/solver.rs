@@ -494,9 +494,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     /// Whether `yes` holds on every rank (every rank calls this together): for decisions the
     /// ranks must take alike, such as reading a cached state only if every rank has its slab.
     pub fn all_ranks(&self, yes: bool) -> bool {
-        let mut count = [0.0];
-        self.comm.sum(&[f64::from(u8::from(yes))], &mut count);
-        count[0] == self.comm.size() as f64
+        self.comm.all(yes)
     }
 
     /// Whether this rank owns global node `p` (its slab, not a ghost layer).
