@@ -67,6 +67,10 @@ pub const BUNDLED: &[(&str, &str)] = &[
         "pinball3d_re100.toml",
         include_str!("../../benchmarks/validation/pinball3d_re100.toml"),
     ),
+    (
+        "pinball3d_re150.toml",
+        include_str!("../../benchmarks/validation/pinball3d_re150.toml"),
+    ),
 ];
 
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
