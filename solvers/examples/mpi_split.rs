@@ -98,13 +98,14 @@ fn run_2d([nx, ny]: [usize; 2], steps: usize, comm: Box<dyn Comm>) -> Result<Run
         rho: 1.0,
         u: [u, 0.0],
     }];
-    let center = [0.3 * nx as f64, 0.47 * ny as f64];
-    let cylinder: Arc<dyn Shape> = Arc::new(Circle {
-        center,
-        radius: 0.12 * ny as f64,
-    });
+    let (center, radius) = ([0.3 * nx as f64, 0.47 * ny as f64], 0.12 * ny as f64);
+    let cylinder: Arc<dyn Shape> = Arc::new(Circle { center, radius });
     let mut s = D2q9::new_split(cfg, vec![cylinder], comm).map_err(|e| e.to_string())?;
-    s.set_wall_velocity(0, |wp| [-0.01 * (wp.position[1] - center[1]), 0.01 * (wp.position[0] - center[0])]);
+    // Spinning at a wall speed of 0.02 whatever the grid.
+    let omega = 0.02 / radius;
+    s.set_wall_velocity(0, |wp| {
+        [-omega * (wp.position[1] - center[1]), omega * (wp.position[0] - center[0])]
+    });
     s.init_with(|x, y| (1.0, u, 1e-3 * ((x as usize * 7 + y as usize * 3) % 5) as f64));
     let mut forces = Vec::new();
     let t0 = Instant::now();
