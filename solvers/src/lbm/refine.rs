@@ -467,7 +467,8 @@ fn restrict(coarse: &mut D2q9, fine: &D2q9, c: &Coupling, interior: bool) {
     });
 }
 
-/// Converts a post-collision non-equilibrium stress between a grid and its 2:1 patch.
+/// Converts a post-collision non-equilibrium stress between a grid and its 2:1 patch (2D and
+/// 3D alike: the factor depends on the stress only through its Frobenius norm).
 ///
 /// Chapman-Enskog gives `Pi^neq = -2 rho c_s^2 tau S` (lattice units), so after a collision
 /// `Pi* = (1 - 1/tau) Pi^neq = -2 rho c_s^2 (tau - 1) S`; the strain rate in lattice units halves
@@ -479,14 +480,20 @@ fn restrict(coarse: &mut D2q9, fine: &D2q9, c: &Coupling, interior: bool) {
 /// carried along with the same factor, as its post-collision value is zero for the regularised
 /// operator anyway.
 #[derive(Clone, Copy, Debug)]
-struct StressMap {
+pub(crate) struct StressMap {
     tau_c: f32,
     tau_f: f32,
     a: f32,
 }
 
+/// Frobenius norm of a 2D stress `[xx, yy, xy]`.
+#[inline]
+fn norm2(q: [f32; 3]) -> f32 {
+    (q[0] * q[0] + q[1] * q[1] + 2.0 * q[2] * q[2]).sqrt()
+}
+
 impl StressMap {
-    fn new(tau_c: f64, tau_f: f64, smagorinsky: f64) -> Self {
+    pub(crate) fn new(tau_c: f64, tau_f: f64, smagorinsky: f64) -> Self {
         StressMap {
             tau_c: tau_c as f32,
             tau_f: tau_f as f32,
@@ -494,10 +501,9 @@ impl StressMap {
         }
     }
 
-    /// `|S|` and the local `tau` of a post-collision stress `q` on a grid with `tau0`.
+    /// `|S|` and the local `tau` of a post-collision stress of norm `norm` on a grid with `tau0`.
     #[inline]
-    fn strain(&self, rho: f32, q: [f32; 3], tau0: f32) -> (f32, f32) {
-        let norm = (q[0] * q[0] + q[1] * q[1] + 2.0 * q[2] * q[2]).sqrt();
+    fn strain(&self, rho: f32, norm: f32, tau0: f32) -> (f32, f32) {
         let b = 1.0 - tau0;
         let c = 1.5 * norm / rho;
         // a s^2 - b s + c = 0, smaller root written without cancellation (a = 0 gives s = c / b).
@@ -506,30 +512,40 @@ impl StressMap {
         (s, tau0 + self.a * s)
     }
 
+    /// The factor that takes a coarse post-collision stress of norm `norm` to the fine grid's.
+    #[inline]
+    pub(crate) fn fine_factor(self, rho: f32, norm: impl FnOnce() -> f32) -> f32 {
+        if self.a == 0.0 {
+            // No square root per node without a subgrid model.
+            return (self.tau_f - 1.0) / (2.0 * (self.tau_c - 1.0));
+        }
+        let (s, tau_c) = self.strain(rho, norm(), self.tau_c);
+        let tau_f = self.tau_f + self.a * 0.5 * s;
+        (tau_f - 1.0) / (2.0 * (tau_c - 1.0))
+    }
+
+    /// The factor that takes a fine post-collision stress of norm `norm` to the coarse grid's.
+    #[inline]
+    pub(crate) fn coarse_factor(self, rho: f32, norm: impl FnOnce() -> f32) -> f32 {
+        if self.a == 0.0 {
+            return 2.0 * (self.tau_c - 1.0) / (self.tau_f - 1.0);
+        }
+        let (s, tau_f) = self.strain(rho, norm(), self.tau_f);
+        let tau_c = self.tau_c + self.a * 2.0 * s;
+        2.0 * (tau_c - 1.0) / (tau_f - 1.0)
+    }
+
     /// Coarse post-collision stress to the fine grid's.
     #[inline]
     fn to_fine(self, rho: f32, q: [f32; 3]) -> [f32; 3] {
-        if self.a == 0.0 {
-            // The same arithmetic as below with s gone: no square root per node.
-            let k = (self.tau_f - 1.0) / (2.0 * (self.tau_c - 1.0));
-            return q.map(|v| k * v);
-        }
-        let (s, tau_c) = self.strain(rho, q, self.tau_c);
-        let tau_f = self.tau_f + self.a * 0.5 * s;
-        let k = (tau_f - 1.0) / (2.0 * (tau_c - 1.0));
+        let k = self.fine_factor(rho, || norm2(q));
         q.map(|v| k * v)
     }
 
     /// Fine post-collision stress to the coarse grid's.
     #[inline]
     fn to_coarse(self, rho: f32, q: [f32; 3]) -> [f32; 3] {
-        if self.a == 0.0 {
-            let k = 2.0 * (self.tau_c - 1.0) / (self.tau_f - 1.0);
-            return q.map(|v| k * v);
-        }
-        let (s, tau_f) = self.strain(rho, q, self.tau_f);
-        let tau_c = self.tau_c + self.a * 2.0 * s;
-        let k = 2.0 * (tau_c - 1.0) / (tau_f - 1.0);
+        let k = self.coarse_factor(rho, || norm2(q));
         q.map(|v| k * v)
     }
 }
@@ -590,8 +606,8 @@ mod tests {
                 assert!((back[k] - q[k]).abs() < 1e-6 * q[2].abs(), "C_s {smagorinsky}: {back:?} vs {q:?}");
             }
             // The strain rate read back on each side halves from coarse to fine.
-            let (s_c, _) = map.strain(1.0, q, tau_c as f32);
-            let (s_f, _) = map.strain(1.0, map.to_fine(1.0, q), tau_f as f32);
+            let (s_c, _) = map.strain(1.0, norm2(q), tau_c as f32);
+            let (s_f, _) = map.strain(1.0, norm2(map.to_fine(1.0, q)), tau_f as f32);
             assert!((s_f / s_c - 0.5).abs() < 1e-4, "C_s {smagorinsky}: {s_c} -> {s_f}");
         }
     }
@@ -603,7 +619,7 @@ mod tests {
             let map = StressMap::new(0.506, 0.512, smagorinsky);
             let g = sheared(0.506, 0.01, smagorinsky);
             let (_, _, _, q) = crate::lbm::collision::hermite_stress(&g);
-            let (s, _) = map.strain(1.0, q, 0.506);
+            let (s, _) = map.strain(1.0, norm2(q), 0.506);
             let expected = 0.01 / 2f32.sqrt();
             assert!((s / expected - 1.0).abs() < 1e-5, "C_s {smagorinsky}: |S| {s} vs {expected}");
         }

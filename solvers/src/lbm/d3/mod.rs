@@ -20,6 +20,7 @@
 mod collision;
 mod kernel;
 pub mod lattice;
+mod refine;
 mod sides;
 mod solver;
 mod sponge;
@@ -27,6 +28,7 @@ pub mod thermal;
 
 pub use super::part::split_axis;
 pub use lattice::{D3q19, D3q27, Lattice3};
+pub use refine::{Patch3, Refined3};
 pub use sides::{Face, Faces};
 pub use solver::{D3Config, Grid3, Lbm3};
 pub use sponge::Sponge3;

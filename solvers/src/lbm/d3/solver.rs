@@ -486,6 +486,11 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         self.time
     }
 
+    /// Restarts the step count (a refined grid's levels after a new initial state).
+    pub(crate) fn reset_time(&mut self) {
+        self.time = 0;
+    }
+
     /// This rank's number and the number of ranks the box is split over.
     pub fn rank(&self) -> (usize, usize) {
         (self.comm.rank(), self.comm.size())
@@ -546,6 +551,21 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
     /// Populations of local node `l` (shifted, `f_i - w_i`).
     fn populations(&self, l: [usize; 3]) -> [f32; Q] {
         std::array::from_fn(|i| self.f[index::<Q>(self.cfg.n, l, i)])
+    }
+
+    /// Populations of node `p` of a box this process holds whole (a refinement interface's
+    /// reads; local and global indices agree there).
+    pub(crate) fn node_populations(&self, p: [usize; 3]) -> [f32; Q] {
+        debug_assert_eq!(self.comm.size(), 1, "refinement couples whole boxes");
+        self.populations(p)
+    }
+
+    /// Overwrites the populations of node `p` of a box this process holds whole.
+    pub(crate) fn set_node_populations(&mut self, p: [usize; 3], g: &[f32; Q]) {
+        debug_assert_eq!(self.comm.size(), 1, "refinement couples whole boxes");
+        for (i, v) in g.iter().enumerate() {
+            self.f[index::<Q>(self.cfg.n, p, i)] = *v;
+        }
     }
 
     fn local_rho_u(&self, l: [usize; 3]) -> (f64, [f64; 3]) {
