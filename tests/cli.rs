@@ -544,6 +544,18 @@ fn bench_refine_quick_reports_the_ratio_to_the_uniform_kernel() {
             assert!(e.as_f64().unwrap() < 0.01, "{out}");
         }
     }
+    // In 3D: a 64^3 box and the 65^3 fine nodes over its middle 32^3 cells.
+    let o = hgym(&["bench", "refine", "--lattice", "d3q19", "--quick", "--json"]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    assert_eq!(v["lattice"], "d3q19");
+    for r in v["rows"].as_array().unwrap() {
+        assert_eq!(r["node_updates_per_step"], 64 * 64 * 64 + 2 * 65 * 65 * 65);
+        for e in r["check_error"].as_array().unwrap() {
+            assert!(e.as_f64().unwrap() < 0.01, "{out}");
+        }
+    }
 }
 
 #[test]

@@ -10,15 +10,20 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
+use hgym_solvers::lbm::d3::{D3Config, D3q19, D3q27, Lattice3, Lbm3, Patch3, Refined3};
 use hgym_solvers::lbm::{Collision, D2q9, D2q9Config, Patch, Refined, Sides};
 use serde::{Deserialize, Serialize};
 
-use super::BenchError;
+use super::{BenchError, BenchLattice};
+
+fn d2q9() -> String {
+    "d2q9".into()
+}
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct RefineBenchRow {
     pub threads: usize,
-    /// Coarse grid (periodic, `n x n`).
+    /// Coarse grid side (periodic, `n x n` or `n x n x n`).
     pub n: usize,
     /// Nodes per coarse step: the coarse grid's plus twice the patch's.
     pub node_updates_per_step: usize,
@@ -35,6 +40,9 @@ pub struct RefineBenchRow {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct RefineBenchReport {
     pub schema: String,
+    /// `d2q9`, `d3q19` or `d3q27`.
+    #[serde(default = "d2q9")]
+    pub lattice: String,
     pub collision: String,
     pub rows: Vec<RefineBenchRow>,
     /// Smallest ratio accepted with all threads.
@@ -45,12 +53,27 @@ pub struct RefineBenchReport {
 
 #[derive(Clone, Debug)]
 pub struct RefineBenchOptions {
+    /// D2Q9 (a square grid) or a 3D set (a cube).
+    pub lattice: BenchLattice,
     /// Coarse grid side; the patch covers the middle half of each direction (a quarter of the
-    /// area, so the patch has as many nodes as the coarse grid).
+    /// area, an eighth of the volume, so the patch has about as many nodes as the coarse grid).
     pub n: usize,
     pub threads: Vec<usize>,
     /// Seconds of timed stepping per measurement.
     pub seconds: f64,
+}
+
+impl RefineBenchOptions {
+    /// The defaults for `lattice`: a 3D cube of 96^3 coarse nodes (134 MB for the D3Q19 A-B
+    /// pair, far beyond the last-level cache) and its 97^3-node patch.
+    pub fn for_lattice(lattice: BenchLattice) -> Self {
+        let n = if lattice == BenchLattice::D2q9 { 1008 } else { 96 };
+        RefineBenchOptions {
+            lattice,
+            n,
+            ..Default::default()
+        }
+    }
 }
 
 impl Default for RefineBenchOptions {
@@ -61,6 +84,7 @@ impl Default for RefineBenchOptions {
         // plain-store rates at 1 thread: 82, 85, 96 MLUPS at nx 1024, 1025, 1026 against 118-139
         // at 1027-1049), so a 1024 grid's 1025-wide patch would time the aliasing, not the coupling.
         RefineBenchOptions {
+            lattice: BenchLattice::D2q9,
             n: 1008,
             threads: vec![1, 2],
             seconds: 1.5,
@@ -99,6 +123,67 @@ fn check(grid: &D2q9, origin: f64, dx: f64, n: usize, t: f64) -> f64 {
     err
 }
 
+/// [`check`] on a 3D grid's mid-plane. The 3D vortex is uniform along z and twice as long as
+/// the 2D one (wavelength `n / 2`: the boxes are smaller), so it is `vortex(2 n, ..)`.
+fn check3<const Q: usize, L: Lattice3<Q>>(grid: &Lbm3<Q, L>, n: usize, t: f64) -> f64 {
+    let c = grid.config();
+    let z = c.n[2] / 2;
+    let mut err = 0.0f64;
+    for y in (0..c.n[1]).step_by((c.n[1] / 32).max(1)) {
+        for x in (0..c.n[0]).step_by((c.n[0] / 32).max(1)) {
+            let (_, u) = grid.rho_u([x, y, z]);
+            let p = c.grid.position([x, y, z]);
+            let (_, ue, ve) = vortex(2 * n, t, p[0], p[1]);
+            err = err.max((u[0] - ue).abs().max((u[1] - ve).abs()) / U0);
+        }
+    }
+    err
+}
+
+/// One row of the 3D benchmark: the uniform box and the box with a patch over its middle
+/// eighth, timed alike.
+fn row3<const Q: usize, L: Lattice3<Q>>(n: usize, threads: usize, seconds: f64) -> Result<RefineBenchRow, BenchError> {
+    let cfg = || {
+        let mut c = D3Config::new([n; 3], TAU);
+        c.collision = Collision::Regularized;
+        c.check_interval = 0;
+        c
+    };
+    let at = |x: usize, y: usize, _z: usize| {
+        let (rho, u, v) = vortex(2 * n, 0.0, x as f64, y as f64);
+        (rho, [u, v, 0.0])
+    };
+    let mut uniform = Lbm3::<Q, L>::new(cfg(), &[])?;
+    uniform.set_equilibrium(at);
+    let uniform_rate = time_steps(seconds, |k| (0..k).try_for_each(|_| uniform.step()))?;
+    let uniform_mlups = uniform_rate * (n * n * n) as f64 / 1e6;
+    drop(uniform);
+
+    let patch = Patch3 {
+        lo: [n / 4; 3],
+        hi: [3 * n / 4; 3],
+    };
+    let mut refined = Refined3::<Q, L>::new(cfg(), &[patch], &[])?;
+    refined.init_with(|p| {
+        let (rho, u, v) = vortex(2 * n, 0.0, p[0], p[1]);
+        (rho, [u, v, 0.0])
+    });
+    let rate = time_steps(seconds, |k| (0..k).try_for_each(|_| refined.step()))?;
+    let updates = refined.node_updates_per_step();
+    let refined_mlups = rate * updates as f64 / 1e6;
+    refined.sync();
+    let t = refined.time() as f64;
+    Ok(RefineBenchRow {
+        threads,
+        n,
+        node_updates_per_step: updates,
+        uniform_mlups,
+        refined_mlups,
+        ratio: refined_mlups / uniform_mlups,
+        check_error: [check3(refined.coarse(), n, t), check3(&refined.levels()[1], n, t)],
+    })
+}
+
 /// Steps `step` for about `seconds` (best of three timings after a calibration); returns steps
 /// per second.
 fn time_steps(seconds: f64, mut step: impl FnMut(u64) -> Result<(), hgym_solvers::lbm::LbmError>) -> Result<f64, BenchError> {
@@ -119,8 +204,11 @@ fn time_steps(seconds: f64, mut step: impl FnMut(u64) -> Result<(), hgym_solvers
 /// Runs the benchmark (regularised collision, the validation cases' operator).
 pub fn bench_refine(opts: &RefineBenchOptions, progress: &mut dyn FnMut(&str)) -> Result<RefineBenchReport, BenchError> {
     let n = opts.n;
-    if n < 64 || !n.is_multiple_of(16) {
-        return Err(BenchError::Input(format!("grid side {n}: use a multiple of 16, at least 64")));
+    let smallest = if opts.lattice == BenchLattice::D2q9 { 64 } else { 32 };
+    if n < smallest || !n.is_multiple_of(16) {
+        return Err(BenchError::Input(format!(
+            "grid side {n}: use a multiple of 16, at least {smallest}"
+        )));
     }
     let cfg = || {
         let mut c = D2q9Config::new(n, n, TAU, Sides::periodic());
@@ -136,6 +224,11 @@ pub fn bench_refine(opts: &RefineBenchOptions, progress: &mut dyn FnMut(&str)) -
     for &threads in &opts.threads {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
         let row = pool.install(|| -> Result<RefineBenchRow, BenchError> {
+            match opts.lattice {
+                BenchLattice::D3q19 => return row3::<19, D3q19>(n, threads, opts.seconds),
+                BenchLattice::D3q27 => return row3::<27, D3q27>(n, threads, opts.seconds),
+                BenchLattice::D2q9 => {}
+            }
             let mut uniform = D2q9::new(cfg(), vec![])?;
             uniform.init_with(|x, y| vortex(n, 0.0, x, y));
             let uniform_rate = time_steps(opts.seconds, |k| uniform.advance(k))?;
@@ -182,6 +275,7 @@ pub fn bench_refine(opts: &RefineBenchOptions, progress: &mut dyn FnMut(&str)) -
     let pass = rows.iter().filter(|r| r.threads == max_threads).all(|r| r.ratio >= target);
     Ok(RefineBenchReport {
         schema: "hgym/bench-refine/v1".into(),
+        lattice: opts.lattice.name().into(),
         collision: Collision::Regularized.name().into(),
         rows,
         target_ratio: target,
@@ -192,8 +286,14 @@ pub fn bench_refine(opts: &RefineBenchOptions, progress: &mut dyn FnMut(&str)) -
 
 impl RefineBenchReport {
     pub fn table(&self) -> String {
+        let (set, part) = if self.lattice == "d2q9" {
+            ("D2Q9", "quarter")
+        } else {
+            (&self.lattice[..], "eighth")
+        };
         let mut s = format!(
-            "D2Q9 with a 2:1 patch over the middle quarter ({} collision); peer: the uniform coarse grid, same run, same threads\n",
+            "{} with a 2:1 patch over the middle {part} ({} collision); peer: the uniform coarse grid, same run, same threads\n",
+            set.to_uppercase(),
             self.collision
         );
         s += &format!(
@@ -204,7 +304,11 @@ impl RefineBenchReport {
             s += &format!(
                 "  {:>7} {:>11} {:>13} {:>14.1} {:>14.1} {:>6.0}%  TG err {:.1e} / {:.1e}\n",
                 r.threads,
-                format!("{}x{}", r.n, r.n),
+                if self.lattice == "d2q9" {
+                    format!("{}x{}", r.n, r.n)
+                } else {
+                    format!("{0}x{0}x{0}", r.n)
+                },
                 r.node_updates_per_step,
                 r.uniform_mlups,
                 r.refined_mlups,

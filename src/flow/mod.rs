@@ -222,7 +222,7 @@ impl FlowSetup {
             }
         }
         if let Some(rf) = &self.refinement {
-            rf.check(d)?;
+            rf.check(d, self.span.as_ref().map(|s| s.z))?;
         }
         match &self.span {
             None => {
@@ -235,9 +235,6 @@ impl FlowSetup {
             }
             Some(span) => {
                 span.check()?;
-                if self.refinement.is_some() {
-                    return Err(bad("refinement", "3D flows run on one uniform grid; remove the refinement regions"));
-                }
                 let duct = self.bodies.iter().any(GeometrySpec::is_duct);
                 let shaped = self.inlet.profile == Profile::Parabolic && duct && self.inlet.reference_velocity == VelocityReference::Mean;
                 if (self.inlet.profile != Profile::Uniform && !shaped) || self.inlet.characteristic_time > 0.0 {

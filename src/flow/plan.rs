@@ -4,6 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use hgym_solvers::lbm::d3::Patch3;
 use hgym_solvers::lbm::{Collision, Patch, Units};
 
 use super::{DomainSpec, FlowError, FlowSetup, Level};
@@ -75,56 +76,67 @@ fn count(v: f64) -> String {
     }
 }
 
-/// Nested refined rectangles `[x0, x1, y0, y1]` (reference lengths), coarsest first: inside the
-/// first the grid is twice as fine as the level's (`cells_per_length` applies outside), inside
-/// the second four times, and so on. Each lies inside the one before; the last contains every
-/// body with some room; the first stays clear of the domain's edges and absorbing layers.
+/// Nested refined regions, coarsest first, in reference lengths: rectangles `[x0, x1, y0, y1]`
+/// in 2D, boxes `[x0, x1, y0, y1, z0, z1]` in 3D. Inside the first the grid is twice as fine as
+/// the level's (`cells_per_length` applies outside), inside the second four times, and so on.
+/// Each lies inside the one before; the last contains every body with some room; the first
+/// stays clear of the domain's edges and absorbing layers.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct RefinementSpec {
-    pub regions: Vec<[f64; 4]>,
+    pub regions: Vec<Vec<f64>>,
 }
 
 impl RefinementSpec {
-    /// Every region a proper rectangle strictly inside the domain or the region before it.
-    pub fn check(&self, d: &DomainSpec) -> Result<(), FlowError> {
+    /// Every region a proper rectangle (a box with a span `z`) strictly inside the domain or the
+    /// region before it.
+    pub fn check(&self, d: &DomainSpec, z: Option<[f64; 2]>) -> Result<(), FlowError> {
         let bad = |message: String| FlowError::Invalid {
             field: "refinement.regions",
             message,
         };
+        let form = if z.is_some() {
+            "[x0, x1, y0, y1, z0, z1]"
+        } else {
+            "[x0, x1, y0, y1]"
+        };
         if self.regions.is_empty() {
-            return Err(bad("list at least one region [x0, x1, y0, y1]".into()));
+            return Err(bad(format!("list at least one region {form}")));
         }
-        let mut outer = [d.x[0], d.x[1], d.y[0], d.y[1]];
+        let mut outer = vec![d.x[0], d.x[1], d.y[0], d.y[1]];
+        outer.extend(z.iter().flatten());
         for (k, region) in self.regions.iter().enumerate() {
-            let [x0, x1, y0, y1] = *region;
-            if !(region.iter().all(|v| v.is_finite()) && x0 < x1 && y0 < y1) {
+            let proper = region.len() == outer.len() && region.iter().all(|v| v.is_finite()) && region.chunks(2).all(|r| r[0] < r[1]);
+            if !proper {
                 return Err(bad(format!(
-                    "region {} must be [x0, x1, y0, y1] with x0 < x1 and y0 < y1, got {region:?}",
+                    "region {} must be {form} with each low end below its high end, got {region:?}",
                     k + 1
                 )));
             }
-            if x0 <= outer[0] || x1 >= outer[1] || y0 <= outer[2] || y1 >= outer[3] {
+            if region.chunks(2).zip(outer.chunks(2)).any(|(r, o)| r[0] <= o[0] || r[1] >= o[1]) {
                 return Err(bad(format!(
                     "region {} {region:?} must lie inside {} {outer:?} with room to spare",
                     k + 1,
                     if k == 0 { "the domain".to_string() } else { format!("region {k}") }
                 )));
             }
-            outer = *region;
+            outer.clone_from(region);
         }
         Ok(())
     }
 }
 
 /// Lattice numbers of the nested patches: each in the node indices of the grid it refines
-/// (ranges inclusive), and the finest grid's cells per length and relaxation time
-/// (`tau_l - 1/2 = 2^l (tau - 1/2)`).
+/// (ranges inclusive; `patches` in 2D, `boxes` in 3D), and the finest grid's cells per length and
+/// relaxation time (`tau_l - 1/2 = 2^l (tau - 1/2)`).
 #[derive(Clone, Debug, Serialize)]
 pub struct RefinementPlan {
     pub patches: Vec<Patch>,
+    pub boxes: Vec<Patch3>,
     pub cells_per_length: f64,
     pub tau: f64,
+    /// Nodes of the finer levels together (for the memory check).
+    pub fine_nodes: usize,
 }
 
 /// Lattice numbers of a flow at one level.
@@ -208,13 +220,9 @@ impl FlowSetup {
             Some(nz) => format!("{} x {} x {nz}", count(nx_f), count(ny_f)),
             None => format!("{} x {}", count(nx_f), count(ny_f)),
         };
-        // A box or a uniform grid is split over the MPI ranks (`flow::ranks`); a refined 2D grid
-        // runs whole on each.
-        let ranks = if nz.is_some() || self.refinement.is_none() {
-            super::ranks::rank().1
-        } else {
-            1
-        };
+        // A uniform grid or box is split over the MPI ranks (`flow::ranks`); a refined one runs
+        // whole on each.
+        let ranks = if self.refinement.is_none() { super::ranks::rank().1 } else { 1 };
         fits_in_memory(&cells, nx_f * ny_f * nz_f * bytes as f64, bytes, ranks, available_memory())?;
         let (nx, ny) = (nx_f.round() as usize, ny_f.round() as usize);
         if nx < 8 || ny < 8 {
@@ -235,28 +243,65 @@ impl FlowSetup {
         // Cell-centred nodes: level-0 node i sits at x0 + (i + 1/2) dx; a patch takes the nodes
         // of the grid it refines that cover its region, and its own node 0 sits on the first.
         let refinement = self.refinement.as_ref().map(|rf| {
-            let mut origin = [d.x[0] + 0.5 * l / n, d.y[0] + 0.5 * l / n];
-            let (mut dx, mut size) = (l / n, [nx, ny]);
-            let mut patches = Vec::new();
-            for [rx0, rx1, ry0, ry1] in rf.regions.iter().copied() {
-                let lo = |v: f64, o: f64, n: usize| (((v - o) / dx).floor().max(0.0) as usize).min(n - 1);
-                let hi = |v: f64, o: f64, n: usize| (((v - o) / dx).ceil().max(0.0) as usize).min(n - 1);
-                let p = Patch {
-                    x: [lo(rx0, origin[0], size[0]), hi(rx1, origin[0], size[0])],
-                    y: [lo(ry0, origin[1], size[1]), hi(ry1, origin[1], size[1])],
-                };
-                origin = [origin[0] + p.x[0] as f64 * dx, origin[1] + p.y[0] as f64 * dx];
-                dx *= 0.5;
-                size = [2 * (p.x[1] - p.x[0]) + 1, 2 * (p.y[1] - p.y[0]) + 1];
-                patches.push(p);
+            let mut origin = vec![d.x[0] + 0.5 * l / n, d.y[0] + 0.5 * l / n];
+            let mut size = vec![nx, ny];
+            if let (Some(span), Some(nz)) = (&self.span, nz) {
+                origin.push(span.z[0] + 0.5 * l / n);
+                size.push(nz);
             }
-            let scale = (1u64 << patches.len()) as f64;
+            let mut dx = l / n;
+            let mut ranges: Vec<Vec<[usize; 2]>> = Vec::new();
+            for region in &rf.regions {
+                let range: Vec<[usize; 2]> = (0..size.len())
+                    .map(|a| {
+                        let at = |v: f64, round: fn(f64) -> f64| (round((v - origin[a]) / dx).max(0.0) as usize).min(size[a] - 1);
+                        [at(region[2 * a], f64::floor), at(region[2 * a + 1], f64::ceil)]
+                    })
+                    .collect();
+                for (a, r) in range.iter().enumerate() {
+                    origin[a] += r[0] as f64 * dx;
+                    size[a] = 2 * (r[1] - r[0]) + 1;
+                }
+                dx *= 0.5;
+                ranges.push(range);
+            }
+            let fine_nodes = ranges
+                .iter()
+                .map(|r| r.iter().map(|[lo, hi]| 2 * (hi - lo) + 1).product::<usize>())
+                .sum();
+            let (patches, boxes) = if nz.is_some() {
+                let boxes = ranges
+                    .iter()
+                    .map(|r| Patch3 {
+                        lo: [r[0][0], r[1][0], r[2][0]],
+                        hi: [r[0][1], r[1][1], r[2][1]],
+                    })
+                    .collect();
+                (vec![], boxes)
+            } else {
+                let patches = ranges.iter().map(|r| Patch { x: r[0], y: r[1] }).collect();
+                (patches, vec![])
+            };
+            let scale = (1u64 << ranges.len()) as f64;
             RefinementPlan {
                 patches,
+                boxes,
                 cells_per_length: scale * n,
                 tau: 0.5 + scale * (tau - 0.5),
+                fine_nodes,
             }
         });
+        if let (Some(r), Some(nz)) = (&refinement, nz) {
+            // A refined box runs whole on each rank, its finer levels beside it.
+            let total = (nx * ny * nz + r.fine_nodes) as f64;
+            fits_in_memory(
+                &format!("{cells} + {} refined", r.fine_nodes),
+                total * bytes as f64,
+                bytes,
+                1,
+                available_memory(),
+            )?;
+        }
         Ok(FlowPlan {
             level,
             units,

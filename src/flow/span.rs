@@ -8,7 +8,7 @@
 use serde::{Deserialize, Serialize};
 
 use hgym_solvers::geometry::{Cuboid, Extruded, Solid, Sphere, StenosedPipe};
-use hgym_solvers::lbm::d3::{D3Config, D3q19, D3q27, Face, Faces, Grid3, Lattice3, Lbm3, Sponge3};
+use hgym_solvers::lbm::d3::{D3Config, D3q19, D3q27, Face, Faces, Grid3, Lattice3, Lbm3, Refined3, Sponge3};
 use hgym_solvers::lbm::LbmError;
 
 use super::{BoundaryKind, EdgeName, FlowError, FlowPlan, FlowSetup, GeometrySpec, Profile};
@@ -138,59 +138,104 @@ impl GeometrySpec {
     }
 }
 
-/// A 3D flow's solver, for either velocity set.
+/// A 3D flow's solver, for either velocity set: one uniform box (split over the MPI ranks) or a
+/// coarse box with nested 2:1 boxes around the bodies (whole on each rank).
 pub enum LbmFlow3 {
     D3q19(Box<Lbm3<19, D3q19>>),
     D3q27(Box<Lbm3<27, D3q27>>),
+    Refined19(Box<Refined3<19, D3q19>>),
+    Refined27(Box<Refined3<27, D3q27>>),
 }
 
-/// Calls the same method on whichever solver `self` holds.
+/// Calls the same method on whichever uniform solver `self` holds, and `$refined` on a refined
+/// one.
 macro_rules! each {
+    ($self:expr, $s:ident => $body:expr, $r:ident => $refined:expr) => {
+        match $self {
+            LbmFlow3::D3q19($s) => $body,
+            LbmFlow3::D3q27($s) => $body,
+            LbmFlow3::Refined19($r) => $refined,
+            LbmFlow3::Refined27($r) => $refined,
+        }
+    };
+}
+
+/// Calls the same method on the box over the whole domain: the uniform solver, or a refined
+/// flow's coarse grid (its faces, inlet and the fields outside the patches).
+macro_rules! whole {
     ($self:expr, $s:ident => $body:expr) => {
         match $self {
             LbmFlow3::D3q19($s) => $body,
             LbmFlow3::D3q27($s) => $body,
+            LbmFlow3::Refined19(r) => {
+                let $s = r.coarse();
+                $body
+            }
+            LbmFlow3::Refined27(r) => {
+                let $s = r.coarse();
+                $body
+            }
+        }
+    };
+    (mut $self:expr, $s:ident => $body:expr) => {
+        match $self {
+            LbmFlow3::D3q19($s) => $body,
+            LbmFlow3::D3q27($s) => $body,
+            LbmFlow3::Refined19(r) => {
+                let $s = r.coarse_mut();
+                $body
+            }
+            LbmFlow3::Refined27(r) => {
+                let $s = r.coarse_mut();
+                $body
+            }
         }
     };
 }
 
 impl LbmFlow3 {
     pub fn step(&mut self) -> Result<(), LbmError> {
-        each!(self, s => s.step())
+        each!(self, s => s.step(), r => r.step())
     }
 
-    /// Force on each body in the level's lattice units.
+    /// Whether the flow runs on nested boxes (environments run on one uniform box).
+    pub fn is_refined(&self) -> bool {
+        matches!(self, LbmFlow3::Refined19(_) | LbmFlow3::Refined27(_))
+    }
+
+    /// Force on each body in the level's lattice units (from the finest box when refined).
     pub fn body_forces(&self) -> &[[f64; 3]] {
-        each!(self, s => s.body_forces())
+        each!(self, s => s.body_forces(), r => r.body_forces())
     }
 
-    /// Force on each (body, segment), `[b * segments + s]`.
+    /// Force on each (body, segment), `[b * segments + s]` (a refined flow has one segment).
     pub fn segment_forces(&self) -> &[[f64; 3]] {
-        each!(self, s => s.segment_forces())
+        each!(self, s => s.segment_forces(), r => r.body_forces())
     }
 
     /// Shapes velocity face `face` by `profile(x)` at each node (see `Lbm3::set_face_profile`).
     pub fn set_face_profile(&mut self, face: usize, profile: impl Fn([f64; 3]) -> f64) -> Result<(), LbmError> {
-        each!(self, s => s.set_face_profile(face, profile))
+        whole!(mut self, s => s.set_face_profile(face, profile))
     }
 
-    /// The velocity of every node (see `Lbm3::velocity_field`).
+    /// The velocity of every node of the whole box (see `Lbm3::velocity_field`; a refined flow's
+    /// coarse grid).
     pub fn velocity_field(&self, u: [&mut [f32]; 3]) -> Result<(), LbmError> {
-        each!(self, s => s.velocity_field(u))
+        whole!(self, s => s.velocity_field(u))
     }
 
     /// Sets the velocity of a velocity face (`2 a` the low end of axis `a`), lattice units.
     pub fn set_face_velocity(&mut self, face: usize, u: [f64; 3]) -> Result<(), LbmError> {
-        each!(self, s => s.set_face_velocity(face, u))
+        whole!(mut self, s => s.set_face_velocity(face, u))
     }
 
     pub fn set_boundary_velocity_scale(&mut self, scale: f64) {
-        each!(self, s => s.set_velocity_scale(scale))
+        whole!(mut self, s => s.set_velocity_scale(scale))
     }
 
-    /// Wall velocity of body `b` at each wall point (lattice velocities).
+    /// Wall velocity of body `b` at each wall point (lattice velocities; every level).
     pub fn set_wall_velocity(&mut self, b: usize, u: impl Fn([f64; 3]) -> [f64; 3]) {
-        each!(self, s => s.set_wall_velocity(b, u))
+        each!(self, s => s.set_wall_velocity(b, u), r => r.set_wall_velocity(b, u))
     }
 
     /// Every fluid node at the equilibrium of `field(x, y, z) = (rho, u)` (physical positions,
@@ -199,70 +244,88 @@ impl LbmFlow3 {
         each!(self, s => {
             let grid = s.config().grid;
             s.set_equilibrium(|x, y, z| field(grid.position([x, y, z])))
-        })
+        }, r => r.init_with(field))
     }
 
-    /// Density and lattice velocity at a physical point (trilinear).
+    /// Density and lattice velocity at a physical point (trilinear; from the finest box that
+    /// holds it).
     pub fn probe(&self, x: [f64; 3]) -> Result<(f64, [f64; 3]), LbmError> {
-        each!(self, s => s.probe(x))
+        each!(self, s => s.probe(x), r => r.probe(x))
     }
 
     /// [`Self::probe`] at each point (one message over the ranks for all of them).
     pub fn probes(&self, xs: &[[f64; 3]]) -> Result<Vec<(f64, [f64; 3])>, LbmError> {
-        each!(self, s => s.probes(xs))
+        each!(self, s => s.probes(xs), r => xs.iter().map(|&x| r.probe(x)).collect())
+    }
+
+    /// Gives a refined flow's coarse grid the fine solution under the patches (before reading
+    /// its fields there); nothing for a uniform one.
+    pub fn sync(&mut self) {
+        each!(self, _s => (), r => r.sync())
     }
 
     pub fn time(&self) -> u64 {
-        each!(self, s => s.time())
+        whole!(self, s => s.time())
     }
 
+    /// Nodes of the box over the whole domain.
     pub fn n(&self) -> [usize; 3] {
-        each!(self, s => s.config().n)
+        whole!(self, s => s.config().n)
     }
 
     pub fn grid(&self) -> Grid3 {
-        each!(self, s => s.config().grid)
+        whole!(self, s => s.config().grid)
     }
 
-    /// Whether node `p` is inside a body (a node this rank holds, under MPI).
+    /// Node updates per step (every level's, `2^l` times on level `l`), for MLUPS.
+    pub fn node_updates_per_step(&self) -> usize {
+        each!(self, s => s.config().n.iter().product(), r => r.node_updates_per_step())
+    }
+
+    /// Whether node `p` of the whole box is inside a body (a node this rank holds, under MPI).
     pub fn is_solid(&self, p: [usize; 3]) -> bool {
-        each!(self, s => s.is_solid(p))
+        whole!(self, s => s.is_solid(p))
     }
 
-    /// Density and lattice velocity of node `p` (a node this rank holds, under MPI).
+    /// Density and lattice velocity of node `p` of the whole box (a node this rank holds).
     pub fn rho_u(&self, p: [usize; 3]) -> (f64, [f64; 3]) {
-        each!(self, s => s.rho_u(p))
+        whole!(self, s => s.rho_u(p))
     }
 
-    /// Lattice velocity of every node of plane `z`, `[y nx + x]`, `None` inside bodies (every
-    /// rank gets the whole plane).
+    /// Lattice velocity of every node of plane `z` of the whole box, `[y nx + x]`, `None` inside
+    /// bodies (every rank gets the whole plane; [`Self::sync`] first when refined).
     pub fn velocity_plane(&self, z: usize) -> Vec<Option<[f64; 3]>> {
-        each!(self, s => s.velocity_plane(z))
+        whole!(self, s => s.velocity_plane(z))
     }
 
-    /// This process's rank and the number of ranks the box is split over.
+    /// This process's rank and the number of ranks the box is split over (a refined flow runs
+    /// whole on each).
     pub fn rank(&self) -> (usize, usize) {
-        each!(self, s => s.rank())
+        each!(self, s => s.rank(), _r => (0, 1))
     }
 
     /// Whether `yes` holds on every rank (every rank must ask together).
     pub fn all_ranks(&self, yes: bool) -> bool {
-        each!(self, s => s.all_ranks(yes))
+        each!(self, s => s.all_ranks(yes), _r => yes)
     }
 
-    /// Mass body `b`'s moving walls inject per step (lattice units; see `Lbm3::wall_mass_source`).
+    /// Mass body `b`'s moving walls inject per step (lattice units; see `Lbm3::wall_mass_source`;
+    /// the coarse grid's when refined).
     pub fn wall_mass_source(&self, b: usize) -> f64 {
-        each!(self, s => s.wall_mass_source(b))
+        whole!(self, s => s.wall_mass_source(b))
     }
 
-    /// The populations (the state a developed-flow cache keeps).
+    /// The populations (the state a developed-flow cache keeps) of the whole box.
     pub fn populations(&self) -> &[f32] {
-        each!(self, s => s.populations_raw())
+        whole!(self, s => s.populations_raw())
     }
 
     /// Restores populations of a solver of the same set-up and level, and the step count.
     pub fn set_populations(&mut self, f: &[f32], time: u64) -> Result<(), LbmError> {
-        each!(self, s => s.set_populations(f, time))
+        each!(self, s => s.set_populations(f, time), _r => Err(LbmError::Config {
+            field: "refinement",
+            message: "a refined flow's state is not restored from one box's populations; remove the refinement".into(),
+        }))
     }
 }
 
@@ -330,9 +393,15 @@ impl FlowSetup {
             .collect();
         let solids: Vec<Box<dyn Solid>> = self.bodies.iter().map(GeometrySpec::solid).collect();
         let bodies: Vec<&dyn Solid> = solids.iter().map(|b| b.as_ref()).collect();
-        let built = match span.lattice {
-            Lattice3Name::D3q19 => Lbm3::<19, D3q19>::new_split(cfg, &bodies, super::ranks::comm()).map(|s| LbmFlow3::D3q19(Box::new(s))),
-            Lattice3Name::D3q27 => Lbm3::<27, D3q27>::new_split(cfg, &bodies, super::ranks::comm()).map(|s| LbmFlow3::D3q27(Box::new(s))),
+        let built = match (span.lattice, &plan.refinement) {
+            (Lattice3Name::D3q19, None) => {
+                Lbm3::<19, D3q19>::new_split(cfg, &bodies, super::ranks::comm()).map(|s| LbmFlow3::D3q19(Box::new(s)))
+            }
+            (Lattice3Name::D3q27, None) => {
+                Lbm3::<27, D3q27>::new_split(cfg, &bodies, super::ranks::comm()).map(|s| LbmFlow3::D3q27(Box::new(s)))
+            }
+            (Lattice3Name::D3q19, Some(r)) => Refined3::<19, D3q19>::new(cfg, &r.boxes, &bodies).map(|s| LbmFlow3::Refined19(Box::new(s))),
+            (Lattice3Name::D3q27, Some(r)) => Refined3::<27, D3q27>::new(cfg, &r.boxes, &bodies).map(|s| LbmFlow3::Refined27(Box::new(s))),
         };
         let mut built = built.map_err(|e| match e {
             LbmError::Config { field, message } => FlowError::Invalid { field, message },
@@ -401,6 +470,46 @@ sponges = []
         assert!((s.reference_area() - std::f64::consts::FRAC_PI_4).abs() < 1e-15);
         // The 2D builder refuses it.
         assert!(matches!(s.build(&plan), Err(FlowError::Invalid { field: "span", .. })));
+    }
+
+    #[test]
+    fn refinement_boxes_take_the_nodes_covering_their_regions_and_build_the_refined_solver() {
+        let span = "span = { z = [0.0, 8.0], boundary = \"free-slip\" }";
+        let s = setup(&sphere(&format!(
+            "{span}\nrefinement = {{ regions = [[2.5, 6.0, 2.75, 5.25, 3.0, 5.0]] }}"
+        )));
+        s.check().unwrap();
+        let plan = s.plan(Level::Coarse).unwrap();
+        let r = plan.refinement.as_ref().unwrap();
+        // Coarse nodes at (i + 1/2) / 4: x 2.5 lies between nodes 9 and 10, 6.0 between 23 and 24.
+        assert_eq!(r.boxes.len(), 1);
+        assert_eq!((r.boxes[0].lo, r.boxes[0].hi), ([9, 10, 11], [24, 21, 20]));
+        assert_eq!((r.cells_per_length, r.fine_nodes), (8.0, 31 * 23 * 19));
+        assert!((r.tau - (0.5 + 2.0 * (plan.tau - 0.5))).abs() < 1e-12);
+        let mut flow = s.build3(&plan).unwrap();
+        assert!(flow.is_refined());
+        assert_eq!(flow.node_updates_per_step(), 48 * 32 * 32 + 2 * 31 * 23 * 19);
+        flow.init_with(|_| (1.0, [0.05, 0.0, 0.0]));
+        for _ in 0..5 {
+            flow.step().unwrap();
+        }
+        assert!(flow.body_forces()[0][0] > 0.0);
+        // A probe inside the box reads the fine grid, one outside the coarse: both the free stream
+        // far upstream.
+        let (_, u) = flow.probe([0.5, 4.0, 4.0]).unwrap();
+        assert!((u[0] - 0.05).abs() < 1e-3, "{u:?}");
+
+        let field = |regions: &str| match setup(&sphere(&format!("{span}\nrefinement = {{ regions = {regions} }}"))).check() {
+            Err(FlowError::Invalid { field, message }) => format!("{field}: {message}"),
+            other => format!("{other:?}"),
+        };
+        let flat = field("[[2.5, 6.0, 2.75, 5.25]]");
+        assert!(
+            flat.starts_with("refinement.regions: region 1 must be [x0, x1, y0, y1, z0, z1]"),
+            "{flat}"
+        );
+        let outside = field("[[2.5, 6.0, 2.75, 5.25, 3.0, 8.0]]");
+        assert!(outside.contains("must lie inside the domain"), "{outside}");
     }
 
     #[test]

@@ -59,7 +59,8 @@ pub struct Parameters {
 /// and relaxation time of the finest grid.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct RefinementParams {
-    pub patches: Vec<[usize; 4]>,
+    /// Each patch's node ranges in its parent's nodes: `[x0, x1, y0, y1]`, with `z0, z1` in 3D.
+    pub patches: Vec<Vec<usize>>,
     pub cells_per_length: f64,
     pub tau: f64,
 }
@@ -286,7 +287,12 @@ impl ValidationReport {
                 steps_run: out.steps,
                 mlups: out.mlups,
                 refinement: p.flow.refinement.as_ref().map(|r| RefinementParams {
-                    patches: r.patches.iter().map(|p| [p.x[0], p.x[1], p.y[0], p.y[1]]).collect(),
+                    patches: r
+                        .patches
+                        .iter()
+                        .map(|p| vec![p.x[0], p.x[1], p.y[0], p.y[1]])
+                        .chain(r.boxes.iter().map(|b| vec![b.lo[0], b.hi[0], b.lo[1], b.hi[1], b.lo[2], b.hi[2]]))
+                        .collect(),
                     cells_per_length: r.cells_per_length,
                     tau: r.tau,
                 }),
@@ -378,7 +384,10 @@ impl ValidationReport {
             let patches: Vec<String> = r
                 .patches
                 .iter()
-                .map(|p| format!("x {}..={}, y {}..={}", p[0], p[1], p[2], p[3]))
+                .map(|p| {
+                    let axes = ["x", "y", "z"].iter().zip(p.chunks(2));
+                    axes.map(|(a, r)| format!("{a} {}..={}", r[0], r[1])).collect::<Vec<_>>().join(", ")
+                })
                 .collect();
             s += &format!(
                 "  refined 2:1 x {} around the bodies (each patch in its parent's nodes: {}): {} cells/L, tau {:.5} there\n",

@@ -298,7 +298,7 @@ impl Solver {
     fn node_updates_per_step(&self) -> usize {
         match self {
             Solver::Flat(s) => s.node_updates_per_step(),
-            Solver::Span(s) => s.n().iter().product(),
+            Solver::Span(s) => s.node_updates_per_step(),
         }
     }
 
@@ -310,6 +310,7 @@ impl Solver {
                 vorticity_field(s.coarse(), units, extent)
             }
             Solver::Span(s) => {
+                s.sync();
                 let [nx, ny, nz] = s.n();
                 plane_vorticity(&s.velocity_plane(nz / 2), [nx, ny], units, extent)
             }

@@ -30,6 +30,7 @@
 //! correction: mass is conserved to the interpolation's truncation error, as in Lagrava et al.
 //! A refined box runs in one process (not split over MPI ranks).
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::collision::equilibrium;
@@ -484,10 +485,10 @@ fn weights(i: usize, len: usize) -> ([usize; 4], [f32; 4], usize) {
 }
 
 /// Reads grid `coarse`'s moments on the patch's six faces and interpolates them to the fine
-/// nodes of each face (into `new`).
+/// nodes of each face (into `new`), faces in parallel.
 fn read_faces<const Q: usize, L: Lattice3<Q>>(coarse: &Lbm3<Q, L>, c: &mut Coupling) {
     let lo = c.patch.lo;
-    for face in &mut c.faces {
+    c.faces.par_iter_mut().for_each(|face| {
         let [b, cc] = in_plane(face.axis);
         let [nb, nc] = face.coarse_dims;
         for jc in 0..nc {
@@ -517,55 +518,76 @@ fn read_faces<const Q: usize, L: Lattice3<Q>>(coarse: &Lbm3<Q, L>, c: &mut Coupl
                 face.new[ic * fb + ib] = m;
             }
         }
-    }
+    });
 }
 
 /// Overwrites the patch's outer shell with populations rebuilt from the face moments at time
-/// `t + theta` (coarse steps). Nodes on an edge or corner of the box lie on two or three faces,
-/// which give them the same value (the interpolation across a face is exact at its edge nodes).
+/// `t + theta` (coarse steps), planes in parallel. A node on an edge or corner of the box lies on
+/// two or three faces, which agree there (the interpolation across a face is exact at its edge
+/// nodes); it takes the z face's value, else the y face's.
 fn write_shell<const Q: usize, L: Lattice3<Q>>(fine: &mut Lbm3<Q, L>, c: &Coupling, theta: f32) {
     let n = fine.config().n;
-    for face in &c.faces {
-        let [b, cc] = in_plane(face.axis);
-        let [fb, fc] = face.fine_dims();
-        let at = if face.at == c.patch.lo[face.axis] { 0 } else { n[face.axis] - 1 };
-        for ic in 0..fc {
-            for ib in 0..fb {
-                let (a, z) = (&face.old[ic * fb + ib], &face.new[ic * fb + ib]);
-                let m: Moments = std::array::from_fn(|k| (1.0 - theta) * a[k] + theta * z[k]);
-                let k = c.convert.fine_factor(1.0 + m[0], || stress_norm(&m));
-                let mut p = [0; 3];
-                p[face.axis] = at;
-                p[b] = ib;
-                p[cc] = ic;
-                fine.set_node_populations(p, &rebuild::<Q, L>(&m, k));
+    let [nx, ny, nz] = n;
+    let at = |face: &Face, ib: usize, ic: usize| -> [f32; Q] {
+        let k = ic * face.fine_dims()[0] + ib;
+        let (a, z) = (&face.old[k], &face.new[k]);
+        let m: Moments = std::array::from_fn(|k| (1.0 - theta) * a[k] + theta * z[k]);
+        let f = c.convert.fine_factor(1.0 + m[0], || stress_norm(&m));
+        rebuild::<Q, L>(&m, f)
+    };
+    fine.rewrite_planes(0..nz, |z, _, plane| {
+        let mut put = |x: usize, y: usize, g: [f32; Q]| {
+            for (i, v) in g.iter().enumerate() {
+                plane[(i * ny + y) * nx + x] = *v;
+            }
+        };
+        // Faces are ordered 2 axis + side; a z face holds (x, y), a y face (x, z), an x face (y, z).
+        if z == 0 || z == nz - 1 {
+            let face = &c.faces[4 + usize::from(z != 0)];
+            for y in 0..ny {
+                for x in 0..nx {
+                    put(x, y, at(face, x, y));
+                }
+            }
+            return;
+        }
+        for (y, face) in [(0, &c.faces[2]), (ny - 1, &c.faces[3])] {
+            for x in 0..nx {
+                put(x, y, at(face, x, z));
             }
         }
-    }
+        for y in 1..ny - 1 {
+            put(0, y, at(&c.faces[0], y, z));
+            put(nx - 1, y, at(&c.faces[1], y, z));
+        }
+    });
 }
 
 /// Gives coarse fluid nodes strictly inside the patch the moments of the fine node on them: every
-/// such node with `interior`, else only the layer next to the patch's faces.
+/// such node with `interior`, else only the layer next to the patch's faces (planes in parallel).
 fn restrict<const Q: usize, L: Lattice3<Q>>(coarse: &mut Lbm3<Q, L>, fine: &Lbm3<Q, L>, c: &Coupling, interior: bool) {
     let (lo, hi) = (c.patch.lo, c.patch.hi);
+    let [nx, ny, _] = coarse.config().n;
     let on_ring = |v: usize, a: usize| v == lo[a] + 1 || v + 1 == hi[a];
-    for z in lo[2] + 1..hi[2] {
+    coarse.rewrite_planes(lo[2] + 1..hi[2], |z, solid, plane| {
         for y in lo[1] + 1..hi[1] {
             let whole_row = interior || on_ring(y, 1) || on_ring(z, 2);
             for x in lo[0] + 1..hi[0] {
                 if !whole_row && !on_ring(x, 0) {
                     continue;
                 }
-                let (p, q) = ([x, y, z], [2 * (x - lo[0]), 2 * (y - lo[1]), 2 * (z - lo[2])]);
-                if coarse.is_solid(p) || fine.is_solid(q) {
+                let q = [2 * (x - lo[0]), 2 * (y - lo[1]), 2 * (z - lo[2])];
+                if solid[y * nx + x] || fine.is_solid(q) {
                     continue;
                 }
                 let m = read_moments::<Q, L>(&fine.node_populations(q));
                 let k = c.convert.coarse_factor(1.0 + m[0], || stress_norm(&m));
-                coarse.set_node_populations(p, &rebuild::<Q, L>(&m, k));
+                for (i, v) in rebuild::<Q, L>(&m, k).iter().enumerate() {
+                    plane[(i * ny + y) * nx + x] = *v;
+                }
             }
         }
-    }
+    });
 }
 
 #[cfg(test)]

@@ -560,12 +560,24 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         self.populations(p)
     }
 
-    /// Overwrites the populations of node `p` of a box this process holds whole.
-    pub(crate) fn set_node_populations(&mut self, p: [usize; 3], g: &[f32; Q]) {
+    /// Rewrites planes `zs` of a box this process holds whole, planes in parallel (grid coupling:
+    /// a refined patch's shell and restriction): `rewrite(z, solid, plane)` gets plane `z`'s
+    /// solid flags (`[y nx + x]`) and populations (`[(i ny + y) nx + x]`). A plane's new values
+    /// must depend on its position and the inputs alone, so the result is the same for any thread
+    /// count. Allocates nothing.
+    pub(crate) fn rewrite_planes(&mut self, zs: std::ops::Range<usize>, rewrite: impl Fn(usize, &[bool], &mut [f32]) + Sync) {
         debug_assert_eq!(self.comm.size(), 1, "refinement couples whole boxes");
-        for (i, v) in g.iter().enumerate() {
-            self.f[index::<Q>(self.cfg.n, p, i)] = *v;
-        }
+        let [nx, ny, _] = self.cfg.n;
+        let (solid, z0, nz) = (&self.plan.solid, zs.start, zs.len());
+        self.f
+            .par_chunks_mut(Q * nx * ny)
+            .skip(z0)
+            .take(nz)
+            .enumerate()
+            .for_each(|(k, plane)| {
+                let z = z0 + k;
+                rewrite(z, &solid[z * nx * ny..(z + 1) * nx * ny], plane);
+            });
     }
 
     fn local_rho_u(&self, l: [usize; 3]) -> (f64, [f64; 3]) {
