@@ -47,6 +47,10 @@ pub const BUNDLED: &[(&str, &str)] = &[
     ("sphere_re100.toml", include_str!("../../benchmarks/validation/sphere_re100.toml")),
     ("sphere_re300.toml", include_str!("../../benchmarks/validation/sphere_re300.toml")),
     (
+        "sphere_re100_refined.toml",
+        include_str!("../../benchmarks/validation/sphere_re100_refined.toml"),
+    ),
+    (
         "square3d_re300.toml",
         include_str!("../../benchmarks/validation/square3d_re300.toml"),
     ),
