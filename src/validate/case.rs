@@ -51,6 +51,10 @@ pub const BUNDLED: &[(&str, &str)] = &[
         include_str!("../../benchmarks/validation/sphere_re100_refined.toml"),
     ),
     (
+        "sphere_re300_refined.toml",
+        include_str!("../../benchmarks/validation/sphere_re300_refined.toml"),
+    ),
+    (
         "square3d_re300.toml",
         include_str!("../../benchmarks/validation/square3d_re300.toml"),
     ),
