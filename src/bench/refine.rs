@@ -37,6 +37,20 @@ pub struct RefineBenchRow {
     pub check_error: [f64; 2],
 }
 
+impl RefineBenchRow {
+    fn new(threads: usize, n: usize, updates: usize, uniform_mlups: f64, refined_mlups: f64, check_error: [f64; 2]) -> Self {
+        RefineBenchRow {
+            threads,
+            n,
+            node_updates_per_step: updates,
+            uniform_mlups,
+            refined_mlups,
+            ratio: refined_mlups / uniform_mlups,
+            check_error,
+        }
+    }
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct RefineBenchReport {
     pub schema: String,
@@ -173,15 +187,8 @@ fn row3<const Q: usize, L: Lattice3<Q>>(n: usize, threads: usize, seconds: f64) 
     let refined_mlups = rate * updates as f64 / 1e6;
     refined.sync();
     let t = refined.time() as f64;
-    Ok(RefineBenchRow {
-        threads,
-        n,
-        node_updates_per_step: updates,
-        uniform_mlups,
-        refined_mlups,
-        ratio: refined_mlups / uniform_mlups,
-        check_error: [check3(refined.coarse(), n, t), check3(&refined.levels()[1], n, t)],
-    })
+    let check_error = [check3(refined.coarse(), n, t), check3(&refined.levels()[1], n, t)];
+    Ok(RefineBenchRow::new(threads, n, updates, uniform_mlups, refined_mlups, check_error))
 }
 
 /// Steps `step` for about `seconds` (best of three timings after a calibration); returns steps
@@ -246,15 +253,7 @@ pub fn bench_refine(opts: &RefineBenchOptions, progress: &mut dyn FnMut(&str)) -
                 check(refined.coarse(), 0.0, 1.0, n, t),
                 check(refined.fine(), patch.x[0] as f64, 0.5, n, t),
             ];
-            Ok(RefineBenchRow {
-                threads,
-                n,
-                node_updates_per_step: updates,
-                uniform_mlups,
-                refined_mlups,
-                ratio: refined_mlups / uniform_mlups,
-                check_error,
-            })
+            Ok(RefineBenchRow::new(threads, n, updates, uniform_mlups, refined_mlups, check_error))
         })?;
         if row.check_error.iter().any(|e| *e > 0.01) {
             return Err(BenchError::Check(format!(

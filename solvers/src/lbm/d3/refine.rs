@@ -261,7 +261,6 @@ impl<const Q: usize, L: Lattice3<Q>> Refined3<Q, L> {
         for grid in &mut self.levels {
             let g = grid.config().grid;
             grid.set_equilibrium(|x, y, z| field(g.position([x, y, z])));
-            // The time restarts with the state (a developed flow is restored by `set_state`).
             grid.reset_time();
         }
         for l in 0..self.couplings.len() {
