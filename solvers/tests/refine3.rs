@@ -1,11 +1,12 @@
 //! 2:1 grid refinement in 3D (one and two nested boxes): a uniform flow stays uniform, a
 //! Taylor-Green vortex decays at the analytic rate through the interfaces, a sphere on a coarse
-//! grid with a fine box around it feels the drag of the uniformly fine grid, unusable patches are
-//! refused, and results do not depend on the thread count or on how much is restricted.
+//! grid with a fine box around it feels the drag of the uniformly fine grid (and so does a
+//! cylinder with a box that covers its periodic span), unusable patches are refused, and results
+//! do not depend on the thread count or on how much is restricted.
 
 use std::f64::consts::PI;
 
-use hgym_solvers::geometry::{Solid, Sphere};
+use hgym_solvers::geometry::{Circle, Extruded, Solid, Sphere};
 use hgym_solvers::lbm::d3::{D3Config, D3q19, D3q27, Face, Faces, Lattice3, Lbm3, Patch3, Refined3, Sponge3};
 use hgym_solvers::lbm::{Collision, LbmError};
 
@@ -71,15 +72,28 @@ fn taylor_green(n: usize, u0: f64, nu: f64, t: f64, x: [f64; 3]) -> (f64, [f64; 
     )
 }
 
+/// The same vortex in the x-z plane, uniform along y.
+fn taylor_green_xz(n: usize, u0: f64, nu: f64, t: f64, x: [f64; 3]) -> (f64, [f64; 3]) {
+    let (rho, u) = taylor_green(n, u0, nu, t, [x[0], x[2], x[1]]);
+    (rho, [u[0], 0.0, u[1]])
+}
+
+type Vortex = fn(usize, f64, f64, f64, [f64; 3]) -> (f64, [f64; 3]);
+
 /// Relative L2 error of `grid`'s velocity against the Taylor-Green solution at time `t`.
 fn tg_error<const Q: usize, L: Lattice3<Q>>(grid: &Lbm3<Q, L>, n: usize, u0: f64, nu: f64, t: f64) -> f64 {
+    vortex_error(grid, taylor_green, n, u0, nu, t)
+}
+
+/// Relative L2 error of `grid`'s velocity against `vortex` at time `t`.
+fn vortex_error<const Q: usize, L: Lattice3<Q>>(grid: &Lbm3<Q, L>, vortex: Vortex, n: usize, u0: f64, nu: f64, t: f64) -> f64 {
     let (mut e2, mut r2) = (0.0, 0.0);
     let c = grid.config();
     for z in 0..c.n[2] {
         for y in 0..c.n[1] {
             for x in 0..c.n[0] {
                 let (_, u) = grid.rho_u([x, y, z]);
-                let (_, ue) = taylor_green(n, u0, nu, t, c.grid.position([x, y, z]));
+                let (_, ue) = vortex(n, u0, nu, t, c.grid.position([x, y, z]));
                 e2 += (0..3).map(|a| (u[a] - ue[a]).powi(2)).sum::<f64>();
                 r2 += ue.iter().map(|v| v * v).sum::<f64>();
             }
@@ -124,6 +138,49 @@ fn a_taylor_green_vortex_decays_through_the_interface() {
         "coarse grid with the patch: {e_coarse} vs uniform {e_uniform}"
     );
     assert!(e_fine < e_uniform, "fine patch: {e_fine} vs uniform coarse {e_uniform}");
+    assert!(drift.abs() < 1e-5, "relative mass drift {drift}");
+}
+
+#[test]
+fn a_taylor_green_vortex_decays_through_a_box_that_covers_the_periodic_span() {
+    // The vortex turns in x-z; the box covers z whole (0..=31), so its fine grid wraps along z
+    // and the vortex crosses only its x faces, whose interpolation runs across the wrap.
+    let (n, u0, tau) = (32usize, 0.03, 0.56);
+    let nu = (tau - 0.5) / 3.0;
+    let steps = 300u64;
+    let t = steps as f64;
+    let cfg = D3Config::new([n, 12, n], tau);
+    let mut uniform = Lbm3::<19, D3q19>::new(cfg.clone(), &[]).unwrap();
+    uniform.set_equilibrium(|x, y, z| taylor_green_xz(n, u0, nu, 0.0, [x as f64, y as f64, z as f64]));
+    for _ in 0..steps {
+        uniform.step().unwrap();
+    }
+    let e_uniform = vortex_error(&uniform, taylor_green_xz, n, u0, nu, t);
+
+    let patch = Patch3 {
+        lo: [7, 3, 0],
+        hi: [23, 9, n - 1],
+    };
+    let mut r = Refined3::<19, D3q19>::new(cfg, &[patch], &[]).unwrap();
+    assert_eq!(r.levels()[1].config().n, [33, 13, 2 * n]);
+    r.init_with(|x| taylor_green_xz(n, u0, nu, 0.0, x));
+    let m0 = r.coarse().mass();
+    for _ in 0..steps {
+        r.step().unwrap();
+    }
+    r.sync();
+    let e_coarse = vortex_error(r.coarse(), taylor_green_xz, n, u0, nu, t);
+    let e_fine = vortex_error(&r.levels()[1], taylor_green_xz, n, u0, nu, t);
+    let drift = (r.coarse().mass() - m0) / m0;
+    println!(
+        "x-z Taylor-Green, box over the whole periodic z, after {steps} steps: uniform error {e_uniform:.3e}; \
+         refined coarse {e_coarse:.3e}, fine {e_fine:.3e}; mass drift {drift:.2e}"
+    );
+    assert!(
+        e_coarse < 1.3 * e_uniform,
+        "coarse grid with the box: {e_coarse} vs uniform {e_uniform}"
+    );
+    assert!(e_fine < e_uniform, "fine box: {e_fine} vs uniform coarse {e_uniform}");
     assert!(drift.abs() < 1e-5, "relative mass drift {drift}");
 }
 
@@ -199,6 +256,69 @@ fn a_sphere_on_a_coarse_grid_with_a_fine_box_feels_the_fine_grids_drag() {
     assert!(e_refined < 0.02, "refined C_D {c_refined} vs uniformly fine {c_fine}");
     assert!(
         e_refined < 0.5 * e_coarse,
+        "the box must buy most of the fine grid's accuracy: {e_refined} vs {e_coarse}"
+    );
+}
+
+/// A cylinder (diameter `4 k` nodes) across a channel `48 k x 24 k` with a periodic span of
+/// `6 k` nodes, inlet, outlet and free-slip sides, at Re 20.
+fn cylinder_channel(k: usize) -> (D3Config, Extruded<Circle>) {
+    let (mut cfg, sphere) = sphere_channel(k);
+    cfg.n[2] = 6 * k;
+    cfg.faces.0[4] = Face::Periodic;
+    cfg.faces.0[5] = Face::Periodic;
+    let circle = Circle {
+        center: [sphere.center[0], sphere.center[1]],
+        radius: sphere.radius,
+    };
+    (cfg, Extruded(circle))
+}
+
+#[test]
+fn a_cylinder_with_a_box_over_its_periodic_span_feels_the_fine_grids_drag() {
+    let coarse_steps = 3000;
+    // Drag per unit span: C_D = F / (1/2 u^2 D span).
+    let c_d = |fx: f64, k: usize| fx / (0.5 * 0.05 * 0.05 * 4.0 * k as f64 * 6.0 * k as f64);
+    let (cfg, cylinder) = cylinder_channel(2);
+    let mut fine = Lbm3::<19, D3q19>::new(cfg, &[&cylinder]).unwrap();
+    fine.set_equilibrium(|_, _, _| (1.0, [0.05, 0.0, 0.0]));
+    let mut c_fine = 0.0;
+    for _ in 0..2 * coarse_steps {
+        fine.step().unwrap();
+        c_fine = c_d(fine.body_forces()[0][0], 2);
+    }
+    let (cfg, cylinder) = cylinder_channel(1);
+    let mut coarse = Lbm3::<19, D3q19>::new(cfg.clone(), &[&cylinder]).unwrap();
+    coarse.set_equilibrium(|_, _, _| (1.0, [0.05, 0.0, 0.0]));
+    let mut c_coarse = 0.0;
+    for _ in 0..coarse_steps {
+        coarse.step().unwrap();
+        c_coarse = c_d(coarse.body_forces()[0][0], 1);
+    }
+    let patch = Patch3 {
+        lo: [8, 6, 0],
+        hi: [28, 18, 5],
+    };
+    let mut r = Refined3::<19, D3q19>::new(cfg, &[patch], &[&cylinder]).unwrap();
+    r.init_with(|_| (1.0, [0.05, 0.0, 0.0]));
+    let mut c_refined = 0.0;
+    for _ in 0..coarse_steps {
+        r.step().unwrap();
+        c_refined = c_d(r.body_forces()[0][0], 1);
+    }
+    let (e_refined, e_coarse) = ((c_refined / c_fine - 1.0).abs(), (c_coarse / c_fine - 1.0).abs());
+    println!(
+        "cylinder over a periodic span at Re 20 after {coarse_steps} coarse steps: C_D uniform fine {c_fine:.4}, \
+         uniform coarse {c_coarse:.4} ({:+.2} %), coarse with a box over the span {c_refined:.4} ({:+.2} %)",
+        100.0 * (c_coarse / c_fine - 1.0),
+        100.0 * (c_refined / c_fine - 1.0),
+    );
+    // Measured: 2.6895 fine, 2.9137 coarse (+8.3 %), 2.7410 refined (+1.9 %): the box removes
+    // 77 % of the coarse grid's error. What is left is the 4-cells-per-D grid outside it (a
+    // cylinder's disturbance decays as 1/r, a sphere's as 1/r^2): a box reaching 1 D from the
+    // free-slip sides and 2.5 D from the inlet gives the same 1.9 %.
+    assert!(
+        e_refined < 0.35 * e_coarse,
         "the box must buy most of the fine grid's accuracy: {e_refined} vs {e_coarse}"
     );
 }

@@ -222,7 +222,7 @@ impl FlowSetup {
             }
         }
         if let Some(rf) = &self.refinement {
-            rf.check(d, self.span.as_ref().map(|s| s.z))?;
+            rf.check(d, self.span.as_ref())?;
         }
         match &self.span {
             None => {

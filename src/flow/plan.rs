@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use hgym_solvers::lbm::d3::Patch3;
 use hgym_solvers::lbm::{Collision, Patch, Units};
 
-use super::{DomainSpec, FlowError, FlowSetup, Level};
+use super::{BoundaryKind, DomainSpec, FlowError, FlowSetup, Level, SpanSpec};
 
 /// Largest lattice speed anywhere on the inlet (Mach 0.3 = 0.173 lattice units): above it the
 /// compressibility error of the LBM exceeds a few percent.
@@ -80,7 +80,9 @@ fn count(v: f64) -> String {
 /// in 2D, boxes `[x0, x1, y0, y1, z0, z1]` in 3D. Inside the first the grid is twice as fine as
 /// the level's (`cells_per_length` applies outside), inside the second four times, and so on.
 /// Each lies inside the one before; the last contains every body with some room; the first
-/// stays clear of the domain's edges and absorbing layers.
+/// stays clear of the domain's edges and absorbing layers. Along a periodic span a box may cover
+/// the whole span instead (`z0`, `z1` at or beyond its ends: a body extruded along it), and a box
+/// inside one that does may too.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct RefinementSpec {
@@ -88,9 +90,11 @@ pub struct RefinementSpec {
 }
 
 impl RefinementSpec {
-    /// Every region a proper rectangle (a box with a span `z`) strictly inside the domain or the
-    /// region before it.
-    pub fn check(&self, d: &DomainSpec, z: Option<[f64; 2]>) -> Result<(), FlowError> {
+    /// Every region a proper rectangle (a box with a span) strictly inside the domain or the
+    /// region before it, or covering a periodic span whole.
+    pub fn check(&self, d: &DomainSpec, span: Option<&SpanSpec>) -> Result<(), FlowError> {
+        let z = span.map(|s| s.z);
+        let periodic_span = span.is_some_and(|s| s.boundary == BoundaryKind::Periodic);
         let bad = |message: String| FlowError::Invalid {
             field: "refinement.regions",
             message,
@@ -105,6 +109,8 @@ impl RefinementSpec {
         }
         let mut outer = vec![d.x[0], d.x[1], d.y[0], d.y[1]];
         outer.extend(z.iter().flatten());
+        // Whether the outer region covers the periodic span (the domain does).
+        let mut wraps = periodic_span;
         for (k, region) in self.regions.iter().enumerate() {
             let proper = region.len() == outer.len() && region.iter().all(|v| v.is_finite()) && region.chunks(2).all(|r| r[0] < r[1]);
             if !proper {
@@ -113,14 +119,24 @@ impl RefinementSpec {
                     k + 1
                 )));
             }
-            if region.chunks(2).zip(outer.chunks(2)).any(|(r, o)| r[0] <= o[0] || r[1] >= o[1]) {
+            let covers = wraps && region[4] <= outer[4] && region[5] >= outer[5];
+            let inside = |a: usize| region[2 * a] > outer[2 * a] && region[2 * a + 1] < outer[2 * a + 1];
+            if !(0..outer.len() / 2).all(|a| inside(a) || (a == 2 && covers)) {
                 return Err(bad(format!(
-                    "region {} {region:?} must lie inside {} {outer:?} with room to spare",
+                    "region {} {region:?} must lie inside {} {outer:?} with room to spare{}",
                     k + 1,
-                    if k == 0 { "the domain".to_string() } else { format!("region {k}") }
+                    if k == 0 { "the domain".to_string() } else { format!("region {k}") },
+                    if wraps { ", or cover the periodic span whole along z" } else { "" }
                 )));
             }
-            outer.clone_from(region);
+            if covers {
+                let span_z = [outer[4], outer[5]];
+                outer.clone_from(region);
+                outer[4..].copy_from_slice(&span_z);
+            } else {
+                outer.clone_from(region);
+            }
+            wraps = covers;
         }
         Ok(())
     }
@@ -242,15 +258,20 @@ impl FlowSetup {
         }
         // Cell-centred nodes: level-0 node i sits at x0 + (i + 1/2) dx; a patch takes the nodes
         // of the grid it refines that cover its region, and its own node 0 sits on the first.
+        // A box covering a periodic span takes every node along it (0..=n - 1, as `Refined3`
+        // reads it) and its grid wraps there with 2 n nodes.
         let refinement = self.refinement.as_ref().map(|rf| {
             let mut origin = vec![d.x[0] + 0.5 * l / n, d.y[0] + 0.5 * l / n];
             let mut size = vec![nx, ny];
+            let mut wraps = vec![false, false];
             if let (Some(span), Some(nz)) = (&self.span, nz) {
                 origin.push(span.z[0] + 0.5 * l / n);
                 size.push(nz);
+                wraps.push(span.boundary == BoundaryKind::Periodic);
             }
             let mut dx = l / n;
             let mut ranges: Vec<Vec<[usize; 2]>> = Vec::new();
+            let mut fine_nodes = 0;
             for region in &rf.regions {
                 let range: Vec<[usize; 2]> = (0..size.len())
                     .map(|a| {
@@ -260,15 +281,13 @@ impl FlowSetup {
                     .collect();
                 for (a, r) in range.iter().enumerate() {
                     origin[a] += r[0] as f64 * dx;
-                    size[a] = 2 * (r[1] - r[0]) + 1;
+                    wraps[a] = wraps[a] && r[0] == 0 && r[1] + 1 == size[a];
+                    size[a] = if wraps[a] { 2 * size[a] } else { 2 * (r[1] - r[0]) + 1 };
                 }
+                fine_nodes += size.iter().product::<usize>();
                 dx *= 0.5;
                 ranges.push(range);
             }
-            let fine_nodes = ranges
-                .iter()
-                .map(|r| r.iter().map(|[lo, hi]| 2 * (hi - lo) + 1).product::<usize>())
-                .sum();
             let (patches, boxes) = if nz.is_some() {
                 let boxes = ranges
                     .iter()

@@ -513,6 +513,55 @@ sponges = []
     }
 
     #[test]
+    fn a_box_may_cover_a_periodic_span_whole_and_its_grid_wraps_there() {
+        let cylinder = |span: &str, regions: &str| {
+            let text = sphere(&format!("{span}\nrefinement = {{ regions = {regions} }}"));
+            setup(&text.replace(
+                r#"shape = "sphere", center = [4.0, 4.0, 4.0]"#,
+                r#"shape = "circle", center = [4.0, 4.0]"#,
+            ))
+        };
+        let periodic = "span = { z = [0.0, 2.0] }";
+        // Two boxes over the whole span (written as the span's ends or beyond them).
+        let s = cylinder(periodic, "[[2.5, 6.0, 2.75, 5.25, 0.0, 2.0], [3.0, 5.5, 3.0, 5.0, -1.0, 3.0]]");
+        s.check().unwrap();
+        let plan = s.plan(Level::Coarse).unwrap();
+        let r = plan.refinement.as_ref().unwrap();
+        assert_eq!(plan.nz, Some(8));
+        assert_eq!(r.boxes[0].lo[2], 0);
+        assert_eq!(r.boxes[0].hi[2], 7);
+        assert_eq!((r.boxes[1].lo[2], r.boxes[1].hi[2]), (0, 15));
+        let [b0, b1] = [r.boxes[0], r.boxes[1]];
+        let n1 = [2 * (b0.hi[0] - b0.lo[0]) + 1, 2 * (b0.hi[1] - b0.lo[1]) + 1, 16];
+        let n2 = [2 * (b1.hi[0] - b1.lo[0]) + 1, 2 * (b1.hi[1] - b1.lo[1]) + 1, 32];
+        assert_eq!(r.fine_nodes, n1.iter().product::<usize>() + n2.iter().product::<usize>());
+        let mut flow = s.build3(&plan).unwrap();
+        assert_eq!(
+            flow.node_updates_per_step(),
+            48 * 32 * 8 + 2 * n1.iter().product::<usize>() + 4 * n2.iter().product::<usize>()
+        );
+        flow.init_with(|_| (1.0, [0.05, 0.0, 0.0]));
+        for _ in 0..3 {
+            flow.step().unwrap();
+        }
+        assert!(flow.body_forces()[0][0] > 0.0);
+
+        // Only a periodic span can be covered.
+        let walls = cylinder(
+            "span = { z = [0.0, 2.0], boundary = \"free-slip\" }",
+            "[[2.5, 6.0, 2.75, 5.25, 0.0, 2.0]]",
+        );
+        match walls.check() {
+            Err(FlowError::Invalid { field, message }) => {
+                assert_eq!(field, "refinement.regions");
+                assert!(message.contains("must lie inside the domain"), "{message}");
+                assert!(!message.contains("cover the periodic span"), "{message}");
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
     fn refuses_what_a_span_cannot_hold() {
         let field = |extra: &str| match setup(&sphere(extra))
             .check()

@@ -26,7 +26,12 @@
 //! `w_i 9/2 Q_i : Pi*`), which is what the regularised collision writes; with BGK the higher-order
 //! non-equilibrium is dropped there. Bodies live on the finest box (forces come from there; the
 //! coarser grids mark them solid too, but their nodes near them are overwritten); faces and
-//! absorbing layers stay on the coarse box, which the patches must keep clear of. No flux
+//! absorbing layers stay on the coarse box, which the patches must keep clear of.
+//!
+//! A patch may also cover a periodic axis of the grid it refines whole (a body extruded along a
+//! periodic span: its range there is every node, `0..=n - 1`). Its fine grid then wraps along that
+//! axis with `2 n` nodes and has no faces across it; the faces along it interpolate across the
+//! wrap (cubic everywhere), and the restriction takes every coarse node along it. No flux
 //! correction: mass is conserved to the interpolation's truncation error, as in Lagrava et al.
 //! A refined box runs in one process (not split over MPI ranks).
 
@@ -40,7 +45,9 @@ use crate::geometry::Solid;
 use crate::lbm::error::LbmError;
 use crate::lbm::refine::{StressMap, FULL_RESTRICTION_EVERY};
 
-/// A refined box in the node indices of the grid it refines, both ends included.
+/// A refined box in the node indices of the grid it refines, both ends included. Along a
+/// periodic axis of that grid, `lo = 0` and `hi = n - 1` make the box cover the axis whole (see
+/// the module docs); otherwise it keeps clear of the grid's faces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Patch3 {
     pub lo: [usize; 3],
@@ -73,6 +80,8 @@ struct Face {
     at: usize,
     /// Coarse nodes along the two in-plane axes.
     coarse_dims: [usize; 2],
+    /// Whether each in-plane axis wraps (the patch covers a periodic axis whole).
+    periodic: [bool; 2],
     coarse: Vec<Moments>,
     old: Vec<Moments>,
     new: Vec<Moments>,
@@ -81,15 +90,34 @@ struct Face {
 impl Face {
     /// Fine nodes along the two in-plane axes.
     fn fine_dims(&self) -> [usize; 2] {
-        self.coarse_dims.map(|n| 2 * n - 1)
+        [0, 1].map(|k| fine_len(self.coarse_dims[k], self.periodic[k]))
+    }
+}
+
+/// Fine nodes over `n` coarse nodes: both ends included, or `2 n` around a periodic axis.
+fn fine_len(n: usize, periodic: bool) -> usize {
+    if periodic {
+        2 * n
+    } else {
+        2 * n - 1
     }
 }
 
 /// The coupling between grid `l` and the patch `l + 1` inside it.
 struct Coupling {
     patch: Patch3,
+    /// The periodic axes the patch covers whole.
+    spans: [bool; 3],
     convert: StressMap,
+    /// The patch's faces across the axes it does not span, in the order (axis, low side first).
     faces: Vec<Face>,
+}
+
+impl Coupling {
+    /// The face normal to `axis` on the high side or the low one, if the patch has it.
+    fn face(&self, axis: usize, high: bool) -> Option<&Face> {
+        self.faces.iter().find(|f| f.axis == axis && (f.at == self.patch.hi[axis]) == high)
+    }
 }
 
 /// A 3D grid over the whole domain with nested 2:1 boxes around the bodies (see the module
@@ -112,7 +140,7 @@ impl<const Q: usize, L: Lattice3<Q>> Refined3<Q, L> {
     /// Plans every grid: `cfg` is the coarse box over the whole domain; `patches[0]` refines a box
     /// of it (coarse node indices), `patches[1]` a box of that patch (its node indices), and so
     /// on. The finest patch must contain every body with a margin; each patch stays clear of the
-    /// faces of the grid it refines and of the absorbing layers.
+    /// faces of the grid it refines and of the absorbing layers, or covers a periodic axis whole.
     pub fn new(cfg: D3Config, patches: &[Patch3], bodies: &[&dyn Solid]) -> Result<Self, LbmError> {
         if patches.is_empty() {
             return Err(config_error("at least one patch is needed (use Lbm3 for a uniform grid)"));
@@ -141,10 +169,16 @@ impl<const Q: usize, L: Lattice3<Q>> Refined3<Q, L> {
                 )));
             }
         }
+        let mut wraps = [0, 1, 2].map(|a| cfg.faces.periodic_axis(a));
+        let mut spans = Vec::with_capacity(patches.len());
         let mut cfgs = vec![cfg];
         for (l, p) in patches.iter().enumerate() {
             let parent = &cfgs[l];
+            let spanned = [0, 1, 2].map(|a| wraps[a] && p.lo[a] == 0 && p.hi[a] + 1 == parent.n[a]);
             for a in 0..3 {
+                if spanned[a] {
+                    continue;
+                }
                 if p.hi[a] < p.lo[a] + 4 {
                     return Err(config_error(format!(
                         "patch {} ({:?}..={:?} in level {l}'s nodes) must span at least 4 cells along each axis",
@@ -155,11 +189,13 @@ impl<const Q: usize, L: Lattice3<Q>> Refined3<Q, L> {
                 }
                 if p.lo[a] < m || p.hi[a] + m >= parent.n[a] {
                     return Err(config_error(format!(
-                        "patch {} ({:?}..={:?}) must keep {m} nodes from the faces of level {l} ({:?} nodes)",
+                        "patch {} ({:?}..={:?}) must keep {m} nodes from the faces of level {l} ({:?} nodes), \
+                         or cover a periodic axis whole (0..={} along it)",
                         l + 1,
                         p.lo,
                         p.hi,
-                        parent.n
+                        parent.n,
+                        parent.n[a] - 1
                     )));
                 }
             }
@@ -173,7 +209,10 @@ impl<const Q: usize, L: Lattice3<Q>> Refined3<Q, L> {
                     l + 1
                 )));
             }
-            let mut fine = D3Config::new([0, 1, 2].map(|a| 2 * (p.hi[a] - p.lo[a]) + 1), tau_f);
+            // The fine grid wraps along the axes it spans (D3Config's faces default to periodic);
+            // its other faces are the shell the coupling rewrites.
+            let n = [0, 1, 2].map(|a| fine_len(p.hi[a] - p.lo[a] + 1, spanned[a]));
+            let mut fine = D3Config::new(n, tau_f);
             fine.grid = Grid3 {
                 origin: parent.grid.position(p.lo),
                 dx: 0.5 * parent.grid.dx,
@@ -185,16 +224,18 @@ impl<const Q: usize, L: Lattice3<Q>> Refined3<Q, L> {
             fine.u_max = parent.u_max;
             fine.stream_stores = parent.stream_stores;
             cfgs.push(fine);
+            spans.push(spanned);
+            wraps = spanned;
         }
         let levels = cfgs
             .into_iter()
             .map(|c| Lbm3::<Q, L>::new(c, bodies))
             .collect::<Result<Vec<_>, _>>()?;
 
-        for (l, p) in patches.iter().enumerate() {
+        for (l, (p, spanned)) in patches.iter().zip(&spans).enumerate() {
             let grid = &levels[l];
             for_each_node(grid.config().n, |q| {
-                let inside = (0..3).all(|a| q[a] > p.lo[a] + 1 && q[a] + 1 < p.hi[a]);
+                let inside = (0..3).all(|a| spanned[a] || (q[a] > p.lo[a] + 1 && q[a] + 1 < p.hi[a]));
                 if grid.is_solid(q) && !inside {
                     return Err(config_error(format!(
                         "node {q:?} of level {l} is inside a body but outside patch {}; every body must lie in every patch",
@@ -208,8 +249,9 @@ impl<const Q: usize, L: Lattice3<Q>> Refined3<Q, L> {
         let finest = &levels[levels.len() - 1];
         let n = finest.config().n;
         let k = BODY_MARGIN_FINE;
+        let spanned = wraps;
         for_each_node(n, |p| {
-            let near = (0..3).any(|a| p[a] < k || p[a] + k >= n[a]);
+            let near = (0..3).any(|a| !spanned[a] && (p[a] < k || p[a] + k >= n[a]));
             if near && finest.is_solid(p) {
                 return Err(config_error(format!(
                     "a body reaches within {k} nodes of the finest patch's faces (node {p:?} of level {}); enlarge the patch",
@@ -220,26 +262,31 @@ impl<const Q: usize, L: Lattice3<Q>> Refined3<Q, L> {
         })?;
         let couplings = patches
             .iter()
+            .zip(&spans)
             .zip(&levels)
-            .map(|(p, coarse)| {
+            .map(|((p, &spanned), coarse)| {
                 let tau_c = coarse.config().tau;
                 let faces = (0..6)
+                    .filter(|f| !spanned[f / 2])
                     .map(|f| {
                         let (axis, high) = (f / 2, f % 2 == 1);
                         let coarse_dims = in_plane(axis).map(|b| p.hi[b] - p.lo[b] + 1);
-                        let fine_len = coarse_dims.iter().map(|n| 2 * n - 1).product();
+                        let periodic = in_plane(axis).map(|b| spanned[b]);
+                        let fine_nodes = fine_len(coarse_dims[0], periodic[0]) * fine_len(coarse_dims[1], periodic[1]);
                         Face {
                             axis,
                             at: if high { p.hi[axis] } else { p.lo[axis] },
                             coarse_dims,
+                            periodic,
                             coarse: vec![[0.0; 10]; coarse_dims[0] * coarse_dims[1]],
-                            old: vec![[0.0; 10]; fine_len],
-                            new: vec![[0.0; 10]; fine_len],
+                            old: vec![[0.0; 10]; fine_nodes],
+                            new: vec![[0.0; 10]; fine_nodes],
                         }
                     })
                     .collect();
                 Coupling {
                     patch: *p,
+                    spans: spanned,
                     convert: StressMap::new(tau_c, 0.5 + 2.0 * (tau_c - 0.5), coarse.config().smagorinsky),
                     faces,
                 }
@@ -392,11 +439,16 @@ impl<const Q: usize, L: Lattice3<Q>> Refined3<Q, L> {
     /// whose box holds it with a node to spare (the coarser ones under a patch need
     /// [`sync`](Self::sync) first, so they are not read there).
     pub fn probe(&self, x: [f64; 3]) -> Result<(f64, [f64; 3]), LbmError> {
-        for grid in self.levels.iter().rev() {
+        for (l, grid) in self.levels.iter().enumerate().rev() {
             let c = grid.config();
+            let spanned = if l == 0 { [false; 3] } else { self.couplings[l - 1].spans };
             let inside = (0..3).all(|a| {
                 let s = (x[a] - c.grid.origin[a]) / c.grid.dx;
-                s >= 1.0 && s <= (c.n[a] - 2) as f64
+                if spanned[a] {
+                    s >= 0.0 && s <= c.n[a] as f64
+                } else {
+                    s >= 1.0 && s <= (c.n[a] - 2) as f64
+                }
             });
             if inside {
                 return grid.probe(x);
@@ -471,11 +523,14 @@ fn rebuild<const Q: usize, L: Lattice3<Q>>(m: &Moments, k: f32) -> [f32; Q] {
 
 /// Coarse nodes and weights of fine index `i` along a line of `len` coarse nodes (`i / 2` in
 /// coarse nodes): the node itself at even `i`, else the 4-point cubic `(-1, 9, 9, -1) / 16`, linear
-/// next to the line's ends.
-fn weights(i: usize, len: usize) -> ([usize; 4], [f32; 4], usize) {
+/// next to the line's ends, or across the wrap of a `periodic` line.
+fn weights(i: usize, len: usize, periodic: bool) -> ([usize; 4], [f32; 4], usize) {
     let k = i / 2;
     if i.is_multiple_of(2) {
         ([k, 0, 0, 0], [1.0, 0.0, 0.0, 0.0], 1)
+    } else if periodic {
+        let at = |d: usize| (k + len + d - 1) % len;
+        ([at(0), at(1), at(2), at(3)], [-1.0 / 16.0, 9.0 / 16.0, 9.0 / 16.0, -1.0 / 16.0], 4)
     } else if k >= 1 && k + 2 < len {
         ([k - 1, k, k + 1, k + 2], [-1.0 / 16.0, 9.0 / 16.0, 9.0 / 16.0, -1.0 / 16.0], 4)
     } else {
@@ -500,10 +555,11 @@ fn read_faces<const Q: usize, L: Lattice3<Q>>(coarse: &Lbm3<Q, L>, c: &mut Coupl
             }
         }
         let [fb, fc] = face.fine_dims();
+        let [pb, pc] = face.periodic;
         for ic in 0..fc {
-            let (kc, wc, mc) = weights(ic, nc);
+            let (kc, wc, mc) = weights(ic, nc, pc);
             for ib in 0..fb {
-                let (kb, wb, mb) = weights(ib, nb);
+                let (kb, wb, mb) = weights(ib, nb, pb);
                 let mut m = [0.0f32; 10];
                 for s in 0..mc {
                     for r in 0..mb {
@@ -523,10 +579,15 @@ fn read_faces<const Q: usize, L: Lattice3<Q>>(coarse: &Lbm3<Q, L>, c: &mut Coupl
 /// Overwrites the patch's outer shell with populations rebuilt from the face moments at time
 /// `t + theta` (coarse steps), planes in parallel. A node on an edge or corner of the box lies on
 /// two or three faces, which agree there (the interpolation across a face is exact at its edge
-/// nodes); it takes the z face's value, else the y face's.
+/// nodes); it takes the z face's value, else the y face's. Along a spanned axis there is no face.
 fn write_shell<const Q: usize, L: Lattice3<Q>>(fine: &mut Lbm3<Q, L>, c: &Coupling, theta: f32) {
     let n = fine.config().n;
     let [nx, ny, nz] = n;
+    let z_faces = [c.face(2, false), c.face(2, true)];
+    let y_faces = [(0, c.face(1, false)), (ny - 1, c.face(1, true))];
+    let x_faces = [(0, c.face(0, false)), (nx - 1, c.face(0, true))];
+    // Rows the x faces own: all but those of the y faces.
+    let rows = if c.spans[1] { 0..ny } else { 1..ny - 1 };
     let at = |face: &Face, ib: usize, ic: usize| -> [f32; Q] {
         let k = ic * face.fine_dims()[0] + ib;
         let (a, z) = (&face.old[k], &face.new[k]);
@@ -540,9 +601,13 @@ fn write_shell<const Q: usize, L: Lattice3<Q>>(fine: &mut Lbm3<Q, L>, c: &Coupli
                 plane[(i * ny + y) * nx + x] = *v;
             }
         };
-        // Faces are ordered 2 axis + side; a z face holds (x, y), a y face (x, z), an x face (y, z).
-        if z == 0 || z == nz - 1 {
-            let face = &c.faces[4 + usize::from(z != 0)];
+        // A z face holds (x, y), a y face (x, z), an x face (y, z).
+        let z_face = match z {
+            0 => z_faces[0],
+            _ if z == nz - 1 => z_faces[1],
+            _ => None,
+        };
+        if let Some(face) = z_face {
             for y in 0..ny {
                 for x in 0..nx {
                     put(x, y, at(face, x, y));
@@ -550,14 +615,19 @@ fn write_shell<const Q: usize, L: Lattice3<Q>>(fine: &mut Lbm3<Q, L>, c: &Coupli
             }
             return;
         }
-        for (y, face) in [(0, &c.faces[2]), (ny - 1, &c.faces[3])] {
-            for x in 0..nx {
-                put(x, y, at(face, x, z));
+        for (y, face) in y_faces {
+            if let Some(face) = face {
+                for x in 0..nx {
+                    put(x, y, at(face, x, z));
+                }
             }
         }
-        for y in 1..ny - 1 {
-            put(0, y, at(&c.faces[0], y, z));
-            put(nx - 1, y, at(&c.faces[1], y, z));
+        for (x, face) in x_faces {
+            if let Some(face) = face {
+                for y in rows.clone() {
+                    put(x, y, at(face, y, z));
+                }
+            }
         }
     });
 }
@@ -567,11 +637,13 @@ fn write_shell<const Q: usize, L: Lattice3<Q>>(fine: &mut Lbm3<Q, L>, c: &Coupli
 fn restrict<const Q: usize, L: Lattice3<Q>>(coarse: &mut Lbm3<Q, L>, fine: &Lbm3<Q, L>, c: &Coupling, interior: bool) {
     let (lo, hi) = (c.patch.lo, c.patch.hi);
     let [nx, ny, _] = coarse.config().n;
-    let on_ring = |v: usize, a: usize| v == lo[a] + 1 || v + 1 == hi[a];
-    coarse.rewrite_planes(lo[2] + 1..hi[2], |z, solid, plane| {
-        for y in lo[1] + 1..hi[1] {
+    // Strictly inside, or every node along a spanned axis (which has no faces and no ring).
+    let inner = |a: usize| if c.spans[a] { lo[a]..hi[a] + 1 } else { lo[a] + 1..hi[a] };
+    let on_ring = |v: usize, a: usize| !c.spans[a] && (v == lo[a] + 1 || v + 1 == hi[a]);
+    coarse.rewrite_planes(inner(2), |z, solid, plane| {
+        for y in inner(1) {
             let whole_row = interior || on_ring(y, 1) || on_ring(z, 2);
-            for x in lo[0] + 1..hi[0] {
+            for x in inner(0) {
                 if !whole_row && !on_ring(x, 0) {
                     continue;
                 }
@@ -609,11 +681,29 @@ mod tests {
         let line = |s: f64| 0.5 - 0.2 * s;
         let len = 9;
         for i in 0..2 * len - 1 {
-            let (k, w, m) = weights(i, len);
+            let (k, w, m) = weights(i, len, false);
             let f: &dyn Fn(f64) -> f64 = if m == 2 { &line } else { &cubic };
             let v: f64 = (0..m).map(|r| w[r] as f64 * f(k[r] as f64)).sum();
             let exact = f(i as f64 / 2.0);
             assert!((v - exact).abs() < 1e-6, "fine index {i} ({m} points): {v} vs {exact}");
         }
+    }
+
+    #[test]
+    fn the_interpolation_around_a_periodic_line_wraps_and_is_fourth_order() {
+        let (k, _, m) = weights(31, 16, true);
+        assert_eq!((k, m), ([14, 15, 0, 1], 4));
+        let error = |len: usize| {
+            let f = |s: f64| (2.0 * std::f64::consts::PI * s / len as f64).sin();
+            (0..2 * len)
+                .map(|i| {
+                    let (k, w, m) = weights(i, len, true);
+                    let v: f64 = (0..m).map(|r| w[r] as f64 * f(k[r] as f64)).sum();
+                    (v - f(i as f64 / 2.0)).abs()
+                })
+                .fold(0.0, f64::max)
+        };
+        let (e16, e32) = (error(16), error(32));
+        assert!(e16 / e32 > 12.0, "errors {e16:.3e} (16 nodes) and {e32:.3e} (32): not fourth order");
     }
 }
