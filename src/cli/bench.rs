@@ -48,6 +48,7 @@ pub enum BenchCommand {
         /// Print one JSON line.
         #[arg(long)]
         json: bool,
+        /// Threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
         /// f32 values per array (default 2^26: 256 MB each).
@@ -113,6 +114,7 @@ pub struct PeerBenchArgs {
     /// Short timings (targets not judged).
     #[arg(long)]
     quick: bool,
+    /// Threads for our side (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
     /// Time the peer beside ours in the same run, alternating (`make peers` installs it).

@@ -139,6 +139,7 @@ pub enum DataCommand {
         /// Output file (default: <file>.recovered.mcap).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Print what was recovered as JSON.
         #[arg(long)]
         json: bool,
     },

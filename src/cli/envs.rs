@@ -28,6 +28,7 @@ pub enum EnvsCommand {
     /// Compute observation statistics from an uncontrolled run and record them.
     Calibrate {
         id: String,
+        /// Resolution level of the run (the statistics are recorded per level).
         #[arg(long, value_enum, default_value_t = Level::Default)]
         level: Level,
         /// Control intervals to average over.
@@ -37,6 +38,7 @@ pub enum EnvsCommand {
         /// benchmarks/envs/normalization.toml or benchmarks/envs/kolmogorov.toml).
         #[arg(long)]
         table: Option<PathBuf>,
+        /// Worker threads (default: all cores); results are bitwise repeatable for the same seed and thread count.
         #[arg(long)]
         threads: Option<usize>,
     },

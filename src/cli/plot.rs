@@ -33,6 +33,7 @@ pub struct LeaderboardArgs {
     /// The results folder.
     #[arg(long, default_value = "results")]
     results: PathBuf,
+    /// Print the leaderboard's entries as JSON.
     #[arg(long)]
     json: bool,
 }

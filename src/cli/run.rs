@@ -24,6 +24,7 @@ pub struct RunArgs {
     /// Resolution level.
     #[arg(long = "res", value_enum, default_value_t = Level::Default)]
     level: Level,
+    /// Seed of the episode's reset (and of a random policy).
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Parent folder of the result folder.
@@ -36,6 +37,7 @@ pub struct RunArgs {
     /// trajectory.mcap at reset and every K actions (0: none).
     #[arg(long, value_name = "K", default_value_t = 0)]
     fields_every: u64,
+    /// Worker threads (default: all cores); results are bitwise repeatable for the same seed and thread count.
     #[arg(long)]
     threads: Option<usize>,
 }

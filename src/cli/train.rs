@@ -79,6 +79,7 @@ pub struct TrainArgs {
     /// Print the final metrics as JSON.
     #[arg(long)]
     json: bool,
+    /// Worker threads (default: all cores); results are bitwise repeatable for the same seed and thread count.
     #[arg(long)]
     threads: Option<usize>,
 }
@@ -101,6 +102,7 @@ pub struct EvalArgs {
     /// Episodes to evaluate (1 to 100000).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     episodes: u64,
+    /// Resolution level.
     #[arg(long = "res", value_enum, default_value_t = Level::Coarse)]
     level: Level,
     /// Episode k starts from reset(eval_seed + k); the default matches training's evaluation.
@@ -117,8 +119,10 @@ pub struct EvalArgs {
     /// actions (0: none; needs --out).
     #[arg(long, value_name = "K", default_value_t = 0, requires = "out")]
     fields_every: u64,
+    /// Print the report as JSON.
     #[arg(long)]
     json: bool,
+    /// Worker threads (default: all cores); results are bitwise repeatable for the same seed and thread count.
     #[arg(long)]
     threads: Option<usize>,
 }
@@ -671,8 +675,10 @@ pub struct CompareArgs {
     /// Only recompute the comparison from finished runs.
     #[arg(long)]
     analyse_only: bool,
+    /// Print the comparison as JSON.
     #[arg(long)]
     json: bool,
+    /// Worker threads (default: all cores); results are bitwise repeatable for the same seed and thread count.
     #[arg(long)]
     threads: Option<usize>,
 }

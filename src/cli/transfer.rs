@@ -33,8 +33,10 @@ pub struct TransferArgs {
     /// Only recompute the comparison from finished arms.
     #[arg(long)]
     analyse_only: bool,
+    /// Print the comparison as JSON.
     #[arg(long)]
     json: bool,
+    /// Worker threads (default: all cores); results are bitwise repeatable for the same seed and thread count.
     #[arg(long)]
     threads: Option<usize>,
 }
