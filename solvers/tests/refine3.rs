@@ -211,47 +211,54 @@ fn drag_coefficient(fx: f64, diameter: f64) -> f64 {
     fx / (0.5 * 0.05 * 0.05 * PI * 0.25 * diameter * diameter)
 }
 
+/// Drag coefficients (`c_d(f_x, k)` with `k` nodes per coarse cell) after `steps` coarse steps
+/// from a uniform start at u 0.05: on the uniformly fine grid (`setup(2)`), the uniformly coarse
+/// one (`setup(1)`) and the coarse one with `patch`; and the node updates per coarse step of the
+/// refined and the fine grid.
+fn drag_three_ways<S: Solid>(
+    setup: impl Fn(usize) -> (D3Config, S),
+    patch: Patch3,
+    steps: usize,
+    c_d: impl Fn(f64, usize) -> f64,
+) -> ([f64; 3], [usize; 2]) {
+    let start = |_, _, _| (1.0, [0.05, 0.0, 0.0]);
+    let uniform = |k: usize| {
+        let (cfg, body) = setup(k);
+        let mut g = Lbm3::<19, D3q19>::new(cfg, &[&body]).unwrap();
+        g.set_equilibrium(start);
+        for _ in 0..k * steps {
+            g.step().unwrap();
+        }
+        (c_d(g.body_forces()[0][0], k), g.config().n.iter().product::<usize>())
+    };
+    let ((c_fine, fine_nodes), (c_coarse, _)) = (uniform(2), uniform(1));
+    let (cfg, body) = setup(1);
+    let mut r = Refined3::<19, D3q19>::new(cfg, &[patch], &[&body]).unwrap();
+    r.init_with(|_| (1.0, [0.05, 0.0, 0.0]));
+    for _ in 0..steps {
+        r.step().unwrap();
+    }
+    let c_refined = c_d(r.body_forces()[0][0], 1);
+    ([c_fine, c_coarse, c_refined], [r.node_updates_per_step(), 2 * fine_nodes])
+}
+
 #[test]
 fn a_sphere_on_a_coarse_grid_with_a_fine_box_feels_the_fine_grids_drag() {
     let coarse_steps = 800;
-    // The uniformly fine grid (8 nodes per diameter).
-    let (cfg, sphere) = sphere_channel(2);
-    let mut fine = Lbm3::<19, D3q19>::new(cfg, &[&sphere]).unwrap();
-    fine.set_equilibrium(|_, _, _| (1.0, [0.05, 0.0, 0.0]));
-    let mut c_fine = 0.0;
-    for _ in 0..2 * coarse_steps {
-        fine.step().unwrap();
-        c_fine = drag_coefficient(fine.body_forces()[0][0], 8.0);
-    }
-    // The uniformly coarse grid (4 nodes per diameter).
-    let (cfg, sphere) = sphere_channel(1);
-    let mut coarse = Lbm3::<19, D3q19>::new(cfg.clone(), &[&sphere]).unwrap();
-    coarse.set_equilibrium(|_, _, _| (1.0, [0.05, 0.0, 0.0]));
-    let mut c_coarse = 0.0;
-    for _ in 0..coarse_steps {
-        coarse.step().unwrap();
-        c_coarse = drag_coefficient(coarse.body_forces()[0][0], 4.0);
-    }
-    // The coarse grid with a fine box around the sphere and its near wake.
+    // 4 nodes per diameter on the coarse grid, 8 on the fine one and in the box around the
+    // sphere and its near wake.
     let patch = Patch3 {
         lo: [8, 6, 6],
         hi: [28, 18, 18],
     };
-    let mut r = Refined3::<19, D3q19>::new(cfg, &[patch], &[&sphere]).unwrap();
-    r.init_with(|_| (1.0, [0.05, 0.0, 0.0]));
-    let mut c_refined = 0.0;
-    for _ in 0..coarse_steps {
-        r.step().unwrap();
-        c_refined = drag_coefficient(r.body_forces()[0][0], 4.0);
-    }
+    let ([c_fine, c_coarse, c_refined], [updates, fine_updates]) =
+        drag_three_ways(sphere_channel, patch, coarse_steps, |fx, k| drag_coefficient(fx, 4.0 * k as f64));
     let (e_refined, e_coarse) = ((c_refined / c_fine - 1.0).abs(), (c_coarse / c_fine - 1.0).abs());
     println!(
         "sphere at Re 20 after {coarse_steps} coarse steps: C_D uniform fine {c_fine:.4}, uniform coarse {c_coarse:.4} \
-         ({:+.2} %), coarse with a fine box {c_refined:.4} ({:+.2} %); node updates per coarse step {} vs {}",
+         ({:+.2} %), coarse with a fine box {c_refined:.4} ({:+.2} %); node updates per coarse step {updates} vs {fine_updates}",
         100.0 * (c_coarse / c_fine - 1.0),
         100.0 * (c_refined / c_fine - 1.0),
-        r.node_updates_per_step(),
-        2 * fine.config().n.iter().product::<usize>()
     );
     assert!(e_refined < 0.02, "refined C_D {c_refined} vs uniformly fine {c_fine}");
     assert!(
@@ -277,35 +284,13 @@ fn cylinder_channel(k: usize) -> (D3Config, Extruded<Circle>) {
 #[test]
 fn a_cylinder_with_a_box_over_its_periodic_span_feels_the_fine_grids_drag() {
     let coarse_steps = 3000;
-    // Drag per unit span: C_D = F / (1/2 u^2 D span).
-    let c_d = |fx: f64, k: usize| fx / (0.5 * 0.05 * 0.05 * 4.0 * k as f64 * 6.0 * k as f64);
-    let (cfg, cylinder) = cylinder_channel(2);
-    let mut fine = Lbm3::<19, D3q19>::new(cfg, &[&cylinder]).unwrap();
-    fine.set_equilibrium(|_, _, _| (1.0, [0.05, 0.0, 0.0]));
-    let mut c_fine = 0.0;
-    for _ in 0..2 * coarse_steps {
-        fine.step().unwrap();
-        c_fine = c_d(fine.body_forces()[0][0], 2);
-    }
-    let (cfg, cylinder) = cylinder_channel(1);
-    let mut coarse = Lbm3::<19, D3q19>::new(cfg.clone(), &[&cylinder]).unwrap();
-    coarse.set_equilibrium(|_, _, _| (1.0, [0.05, 0.0, 0.0]));
-    let mut c_coarse = 0.0;
-    for _ in 0..coarse_steps {
-        coarse.step().unwrap();
-        c_coarse = c_d(coarse.body_forces()[0][0], 1);
-    }
     let patch = Patch3 {
         lo: [8, 6, 0],
         hi: [28, 18, 5],
     };
-    let mut r = Refined3::<19, D3q19>::new(cfg, &[patch], &[&cylinder]).unwrap();
-    r.init_with(|_| (1.0, [0.05, 0.0, 0.0]));
-    let mut c_refined = 0.0;
-    for _ in 0..coarse_steps {
-        r.step().unwrap();
-        c_refined = c_d(r.body_forces()[0][0], 1);
-    }
+    // Drag per unit span: C_D = F / (1/2 u^2 D span).
+    let c_d = |fx: f64, k: usize| fx / (0.5 * 0.05 * 0.05 * 4.0 * k as f64 * 6.0 * k as f64);
+    let ([c_fine, c_coarse, c_refined], _) = drag_three_ways(cylinder_channel, patch, coarse_steps, c_d);
     let (e_refined, e_coarse) = ((c_refined / c_fine - 1.0).abs(), (c_coarse / c_fine - 1.0).abs());
     println!(
         "cylinder over a periodic span at Re 20 after {coarse_steps} coarse steps: C_D uniform fine {c_fine:.4}, \
