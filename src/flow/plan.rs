@@ -129,12 +129,10 @@ impl RefinementSpec {
                     if wraps { ", or cover the periodic span whole along z" } else { "" }
                 )));
             }
-            if covers {
-                let span_z = [outer[4], outer[5]];
-                outer.clone_from(region);
-                outer[4..].copy_from_slice(&span_z);
-            } else {
-                outer.clone_from(region);
+            // A box over the span keeps the span's ends as the next one's bounds along z.
+            outer.clone_from(region);
+            if let (true, Some(z)) = (covers, z) {
+                outer[4..].copy_from_slice(&z);
             }
             wraps = covers;
         }
