@@ -38,8 +38,19 @@ impl BenchLattice {
         }
     }
 
+    /// Fractions of the roofline required at the memory-bound size with all threads and with
+    /// one. D2Q9: 85 % and 75 % (one core cannot use the whole memory system, so its share is
+    /// lower). 3D: 80 % with all threads; one thread is not judged (its kernel is bound by
+    /// arithmetic: its single-thread rate in the last-level cache is no higher than from memory).
+    pub fn targets(self) -> (f64, Option<f64>) {
+        match self {
+            BenchLattice::D2q9 => (0.85, Some(0.75)),
+            _ => (0.8, None),
+        }
+    }
+
     /// A cache-resident, a last-level-cache and a memory-bound size (the last one, well above
-    /// this machine's 300 MB L3).
+    /// this machine's 32 MB L3).
     pub fn default_sizes(self) -> Vec<[usize; 3]> {
         match self {
             // 0.3 MB, 9.4 MB, 302 MB at 72 B per node.
@@ -84,8 +95,11 @@ pub struct BenchReport {
     pub lattice: BenchLattice,
     pub bytes_per_cell: usize,
     pub rows: Vec<BenchRow>,
-    /// Fraction of the roofline required at the memory-bound size.
+    /// Fraction of the roofline required at the memory-bound size with all threads.
     pub target_fraction: f64,
+    /// Fraction required there with one thread, where one is judged.
+    #[serde(default)]
+    pub target_fraction_one_thread: Option<f64>,
     pub pass: bool,
     pub manifest: crate::report::manifest::Manifest,
 }
@@ -285,24 +299,24 @@ pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Resu
             rows.push(row);
         }
     }
-    // The target applies to the whole machine (the most threads) at the memory-bound size: with
-    // fewer cores than the memory system can feed, the kernel is bound by arithmetic (its
-    // single-thread rate in the last-level cache is no higher than from memory).
-    let target = match opts.lattice {
-        BenchLattice::D2q9 => 0.7,
-        _ => 0.8,
-    };
+    let (target, target_one_thread) = opts.lattice.targets();
     let max_threads = rows.iter().map(|r| r.threads).max().unwrap_or(1);
-    let pass = rows
-        .iter()
-        .filter(|r| r.memory_bound && r.threads == max_threads)
-        .all(|r| r.roofline_fraction >= target);
+    let pass = rows.iter().filter(|r| r.memory_bound).all(|r| {
+        if r.threads == max_threads {
+            r.roofline_fraction >= target
+        } else if r.threads == 1 {
+            target_one_thread.is_none_or(|t| r.roofline_fraction >= t)
+        } else {
+            true
+        }
+    });
     Ok(BenchReport {
         schema: "hgym/bench-lbm/v1".into(),
         lattice: opts.lattice,
         bytes_per_cell: bytes,
         rows,
         target_fraction: target,
+        target_fraction_one_thread: target_one_thread,
         pass,
         manifest: crate::report::manifest::manifest(*opts.threads.iter().max().unwrap_or(&1), 0.0),
     })
@@ -343,8 +357,12 @@ impl BenchReport {
                 if r.memory_bound { "  <- memory-bound" } else { "" }
             );
         }
+        let one = match self.target_fraction_one_thread {
+            Some(t) => format!(" and {:.0}% with one", 100.0 * t),
+            None => String::new(),
+        };
         s += &format!(
-            "  target: >= {:.0}% of the roofline at the memory-bound size with all threads: {}\n",
+            "  target: >= {:.0}% of the roofline at the memory-bound size with all threads{one}: {}\n",
             100.0 * self.target_fraction,
             if self.pass { "met" } else { "NOT met" }
         );
