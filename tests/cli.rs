@@ -600,6 +600,8 @@ fn bench_envs_times_only_the_families_asked_for() {
         assert_eq!(r["family"], "stenotic_pipe");
         assert_eq!(r["level"], "coarse");
         assert!(r["actions_per_s"].as_f64().unwrap() > 0.0);
+        let outside = r["outside_share"].as_f64().unwrap();
+        assert!((0.0..1.0).contains(&outside), "share of an action outside the solver: {outside}");
     }
 }
 

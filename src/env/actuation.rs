@@ -94,9 +94,15 @@ impl Jet {
 
     /// The spatial profile `S_j(x)` (zero outside the jet).
     pub fn profile(&self, p: [f64; 2]) -> [f64; 2] {
+        let r = [p[0] - self.center[0], p[1] - self.center[1]];
+        // Most wall points are far from the jet: reject them before the trigonometry (the
+        // actuation is set on every link at every lattice step). `hypot` is within an ulp of
+        // the root, so the margin never rejects a point the exact test below keeps.
+        if r[0] * r[0] + r[1] * r[1] > (1.0 + 1e-9) * self.width * self.width {
+            return [0.0, 0.0];
+        }
         let a = self.angle_deg.to_radians();
         let t = [a.cos(), a.sin()];
-        let r = [p[0] - self.center[0], p[1] - self.center[1]];
         let along = r[0] * t[0] + r[1] * t[1];
         let d_perp = (r[0] - along * t[0]).hypot(r[1] - along * t[1]);
         let half = 0.5 * self.width;
@@ -195,11 +201,31 @@ pub fn section_velocity(spec: &ActuationSpec, jets: &[Jet], centers: &[[f64; 2]]
     u
 }
 
-/// Sets the wall velocity of every link of `body` from a section actuator (see
-/// [`section_velocity`]), converted to lattice units.
-pub fn apply(solver: &mut D2q9, body: usize, spec: &ActuationSpec, jets: &[Jet], centers: &[[f64; 2]], a: &[f64], units: &Units) {
-    solver.set_wall_velocity(body, |wp| {
-        let u = section_velocity(spec, jets, centers, body, a, wp.position);
+/// The wall links (indices into the solver's wall points) that a section actuator can move:
+/// those where some unit action gives a non-zero velocity. Every actuator is linear in the
+/// action, so the other links stay at rest whatever the action, and [`apply`] sets only these
+/// (the actuation is set at every lattice step; most links are far from any jet).
+pub fn moving_links(solver: &D2q9, spec: &ActuationSpec, jets: &[Jet], centers: &[[f64; 2]], act_dim: usize) -> Vec<usize> {
+    let mut unit = vec![0.0; act_dim];
+    let mut moving = Vec::new();
+    for (l, wp) in solver.wall_points().iter().enumerate() {
+        let moves = (0..act_dim).any(|k| {
+            unit.fill(0.0);
+            unit[k] = 1.0;
+            section_velocity(spec, jets, centers, wp.body, &unit, wp.position) != [0.0, 0.0]
+        });
+        if moves {
+            moving.push(l);
+        }
+    }
+    moving
+}
+
+/// Sets the wall velocity of the `moving` links (see [`moving_links`]) from a section actuator
+/// (see [`section_velocity`]), converted to lattice units.
+pub fn apply(solver: &mut D2q9, moving: &[usize], spec: &ActuationSpec, jets: &[Jet], centers: &[[f64; 2]], a: &[f64], units: &Units) {
+    solver.set_link_velocities(moving, |wp| {
+        let u = section_velocity(spec, jets, centers, wp.body, a, wp.position);
         [units.lattice_velocity(u[0]), units.lattice_velocity(u[1])]
     });
 }
@@ -272,11 +298,8 @@ mod tests {
         assert!((u[0]).abs() < 1e-15 && (u[1] - 1.0).abs() < 1e-15);
     }
 
-    /// Zero-net-mass-flux jet pair at 90 and 270 degrees on a cylinder placed symmetrically on the
-    /// grid: the mass the moving-wall terms inject sums to zero to round-off, while one jet alone
-    /// injects a finite amount.
-    #[test]
-    fn znmf_jet_pair_injects_no_net_mass() {
+    /// A closed box of 160 x 96 nodes at 16 per D with a circle of diameter 1 at each centre.
+    fn boxed_circles(centers: &[[f64; 2]]) -> (D2q9, Units) {
         let units = Units {
             cells_per_length: 16.0,
             u_lattice: 0.05,
@@ -288,7 +311,6 @@ mod tests {
             origin: [0.5 * dx, -0.5 * (ny as f64 - 1.0) * dx],
             dx,
         };
-        let center = [3.0, 0.0];
         let sides = Sides {
             west: Side::Wall,
             east: Side::Wall,
@@ -297,8 +319,20 @@ mod tests {
         };
         let mut cfg = D2q9Config::new(nx, ny, units.tau(), sides);
         cfg.grid = grid;
-        let body: Arc<dyn Shape> = Arc::new(Circle { center, radius: 0.5 });
-        let mut s = D2q9::new(cfg, vec![body]).unwrap();
+        let bodies = centers
+            .iter()
+            .map(|&center| Arc::new(Circle { center, radius: 0.5 }) as Arc<dyn Shape>)
+            .collect();
+        (D2q9::new(cfg, bodies).unwrap(), units)
+    }
+
+    /// Zero-net-mass-flux jet pair at 90 and 270 degrees on a cylinder placed symmetrically on the
+    /// grid: the mass the moving-wall terms inject sums to zero to round-off, while one jet alone
+    /// injects a finite amount.
+    #[test]
+    fn znmf_jet_pair_injects_no_net_mass() {
+        let center = [3.0, 0.0];
+        let (mut s, units) = boxed_circles(&[center]);
         let spec = ActuationSpec::ZnmfJets {
             body: 0,
             angles_deg: [90.0, 270.0],
@@ -307,17 +341,97 @@ mod tests {
         };
         let (jets, _) = resolve(&spec, &[GeometrySpec::Circle { center, diameter: 1.0 }]).unwrap();
         let a = 0.8;
-        apply(&mut s, 0, &spec, &jets, &[], &[a], &units);
+        let links = moving_links(&s, &spec, &jets, &[], 1);
+        apply(&mut s, &links, &spec, &jets, &[], &[a], &units);
         let pair = s.wall_mass_source(0);
         let one_jet = ActuationSpec::Jets {
             body: 0,
             jets: jets[..1].to_vec(),
             max_velocity: 1.0,
         };
-        apply(&mut s, 0, &one_jet, &jets[..1], &[], &[a], &units);
+        let (mut s, _) = boxed_circles(&[center]);
+        let links = moving_links(&s, &one_jet, &jets[..1], &[], 1);
+        apply(&mut s, &links, &one_jet, &jets[..1], &[], &[a], &units);
         let one = s.wall_mass_source(0);
         println!("ZNMF pair: net injected mass per step {pair:.3e}; one jet alone {one:.3e}");
         assert!(one.abs() > 1e-4, "a single jet must inject mass ({one})");
         assert!(pair.abs() < 1e-12 * one.abs().max(1.0), "ZNMF pair injects {pair:e}");
+    }
+
+    /// Setting only the links an actuator can move gives the flow that setting every link of
+    /// every body gives, bitwise: jet pairs on two of three cylinders (a few links move) and
+    /// the rotation of two (all their links move, the third's none).
+    #[test]
+    fn setting_only_the_moving_links_changes_nothing() {
+        let centers = [[3.0, 0.0], [4.5, 1.0], [4.5, -1.0]];
+        let bodies: Vec<_> = centers.iter().map(|&center| GeometrySpec::Circle { center, diameter: 1.0 }).collect();
+        let specs = [
+            ActuationSpec::ZnmfJetsPerBody {
+                bodies: vec![1, 2],
+                angles_deg: [90.0, 270.0],
+                span_deg: 20.0,
+                max_velocity: 1.0,
+            },
+            ActuationSpec::Rotation {
+                bodies: vec![1, 2],
+                max_omega: 1.0,
+            },
+        ];
+        for spec in specs {
+            let (jets, centers_of) = resolve(&spec, &bodies).unwrap();
+            let (mut every, units) = boxed_circles(&centers);
+            let (mut moving, _) = boxed_circles(&centers);
+            let links = moving_links(&moving, &spec, &jets, &centers_of, 2);
+            let total = moving.wall_points().len();
+            let on_rotors = moving.wall_points().iter().filter(|w| w.body != 0).count();
+            match spec {
+                ActuationSpec::Rotation { .. } => assert_eq!(links.len(), on_rotors, "{spec:?}"),
+                _ => assert!(!links.is_empty() && links.len() < total / 4, "{} of {total} links move", links.len()),
+            }
+            for k in 0..20 {
+                let a = [0.05 * (k as f64 * 0.7).sin(), -0.03];
+                for b in 0..3 {
+                    every.set_wall_velocity(b, |wp| {
+                        let u = section_velocity(&spec, &jets, &centers_of, b, &a, wp.position);
+                        [units.lattice_velocity(u[0]), units.lattice_velocity(u[1])]
+                    });
+                }
+                apply(&mut moving, &links, &spec, &jets, &centers_of, &a, &units);
+                every.step().unwrap();
+                moving.step().unwrap();
+            }
+            assert!(every.populations() == moving.populations(), "{spec:?}");
+            assert!(every.body_forces()[1][1] != 0.0, "the actuation acts");
+        }
+    }
+
+    /// The profile's early rejection keeps every point the full test keeps: bitwise the textbook
+    /// profile on a fine grid around a jet, its rim included.
+    #[test]
+    fn jet_profile_rejection_changes_no_value() {
+        let jet = Jet::on_circle([0.3, -0.2], 0.5, 63.0, 25.0);
+        let textbook = |p: [f64; 2]| {
+            let a = jet.angle_deg.to_radians();
+            let t = [a.cos(), a.sin()];
+            let r = [p[0] - jet.center[0], p[1] - jet.center[1]];
+            let along = r[0] * t[0] + r[1] * t[1];
+            let d_perp = (r[0] - along * t[0]).hypot(r[1] - along * t[1]);
+            let half = 0.5 * jet.width;
+            if d_perp > half || r[0].hypot(r[1]) > jet.width {
+                return [0.0, 0.0];
+            }
+            let s = 1.0 - (d_perp / half).powi(2);
+            [s * t[0], s * t[1]]
+        };
+        let mut inside = 0;
+        for i in -300..=300 {
+            for j in -300..=300 {
+                let p = [jet.center[0] + i as f64 * jet.width / 250.0, jet.center[1] + j as f64 * jet.width / 250.0];
+                let (new, old) = (jet.profile(p), textbook(p));
+                assert_eq!(new.map(f64::to_bits), old.map(f64::to_bits), "at {p:?}");
+                inside += (old != [0.0, 0.0]) as usize;
+            }
+        }
+        assert!(inside > 1000, "{inside} points inside the jet");
     }
 }

@@ -447,6 +447,7 @@ pub struct ChannelEnv {
     tau_ref: f64,
     actions: usize,
     live: bool,
+    clock: super::clock::SolverClock,
     /// Per-wall-cell scratch: the transpiration of each wall, then the sensing plane's u' and v'.
     plane: [Vec<f64>; 2],
     shear: [Vec<f64>; 2],
@@ -494,6 +495,7 @@ impl ChannelEnv {
             solver,
             actions: 0,
             live: false,
+            clock: Default::default(),
         })
     }
 
@@ -710,7 +712,10 @@ impl Env for ChannelEnv {
         let mut failure = None;
         self.patch_tau.fill(0.0);
         for _ in 0..self.substeps {
-            if let Err(e) = self.solver.step() {
+            let t = std::time::Instant::now();
+            let stepped = self.solver.step();
+            self.clock.stop(t);
+            if let Err(e) = stepped {
                 failure = Some(e.to_string());
                 break;
             }
@@ -862,4 +867,10 @@ pub fn calibrate(
         u_rms_plus: (u2 / n).sqrt(),
         v_rms_plus: (v2 / n).sqrt(),
     })
+}
+
+impl super::clock::SolverTime for ChannelEnv {
+    fn solver_seconds(&self) -> f64 {
+        self.clock.seconds()
+    }
 }

@@ -13,6 +13,7 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use super::fields::FlowFields;
+use super::clock::SolverTime;
 use super::EnvInputError;
 use crate::flow::Level;
 
@@ -24,10 +25,10 @@ pub trait Family: Sync {
 
 /// What a running environment of any family offers: the Gymnasium contract, the reward
 /// gradient where the family is differentiable (an error naming the alternatives elsewhere),
-/// and flow-field snapshots for trajectories.
-pub trait FlowEnv: DifferentiableEnv + FlowFields + Send {}
+/// flow-field snapshots for trajectories, and the time its solver has stepped.
+pub trait FlowEnv: DifferentiableEnv + FlowFields + SolverTime + Send {}
 
-impl<T: DifferentiableEnv + FlowFields + Send> FlowEnv for T {}
+impl<T: DifferentiableEnv + FlowFields + SolverTime + Send> FlowEnv for T {}
 
 /// A family's spec: the description of one ID that builds its environment.
 pub trait FamilySpec: Any + Send + Sync + std::fmt::Debug {

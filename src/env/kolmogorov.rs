@@ -335,6 +335,7 @@ pub struct KolmogorovEnv {
     substeps: usize,
     history: Vec<Record>,
     live: bool,
+    clock: super::clock::SolverClock,
     theta: f64,
     tke_ref: f64,
     obs_scale: f64,
@@ -370,6 +371,7 @@ impl KolmogorovEnv {
             substeps,
             history: vec![],
             live: false,
+            clock: Default::default(),
         })
     }
 
@@ -512,7 +514,10 @@ impl Env for KolmogorovEnv {
         let (mut eps, mut excess, mut tke, mut flow) = (0.0, 0.0, 0.0, 0.0);
         let mut failure = None;
         for _ in 0..m {
-            if let Err(e) = self.solver.step(&physical) {
+            let t = std::time::Instant::now();
+            let stepped = self.solver.step(&physical);
+            self.clock.stop(t);
+            if let Err(e) = stepped {
                 failure = Some(e.to_string());
                 break;
             }
@@ -628,4 +633,10 @@ pub fn calibrate(spec: &KolmogorovSpec, level: Level, actions: usize, progress: 
         dissipation_std: std,
         tke_mean: tke / n,
     })
+}
+
+impl super::clock::SolverTime for KolmogorovEnv {
+    fn solver_seconds(&self) -> f64 {
+        self.clock.seconds()
+    }
 }

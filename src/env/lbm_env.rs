@@ -38,9 +38,12 @@ pub struct LbmEnv {
     steps_per_action: u64,
     jets: Vec<Jet>,
     centers: Vec<[f64; 2]>,
+    /// The wall links the actuator can move (`actuation::moving_links`).
+    moving: Vec<usize>,
     a_old: Vec<f64>,
     actions_taken: usize,
     live: bool,
+    clock: super::clock::SolverClock,
     attractor: Option<Vec<f32>>,
     cache_dir: Option<PathBuf>,
     t0: u64,
@@ -122,6 +125,7 @@ impl LbmEnv {
         let (jets, centers) =
             super::actuation::resolve(&spec.actuation, &spec.bodies).map_err(|m| EnvError::InvalidSpec(format!("{}: {m}", spec.id)))?;
         let act_dim = spec.act_dim();
+        let moving = super::actuation::moving_links(&solver, &spec.actuation, &jets, &centers, act_dim);
         Ok(LbmEnv {
             spec,
             level,
@@ -130,9 +134,11 @@ impl LbmEnv {
             steps_per_action,
             jets,
             centers,
+            moving,
             a_old: vec![0.0; act_dim],
             actions_taken: 0,
             live: false,
+            clock: Default::default(),
             attractor: None,
             cache_dir,
             t0: 0,
@@ -166,9 +172,7 @@ impl LbmEnv {
 
     /// Sets the wall velocities for physical actuation `a` (units of U or U/D).
     fn actuate(&mut self, a: &[f64]) {
-        for b in 0..self.spec.bodies.len() {
-            apply(&mut self.solver, b, &self.spec.actuation, &self.jets, &self.centers, a, &self.units);
-        }
+        apply(&mut self.solver, &self.moving, &self.spec.actuation, &self.jets, &self.centers, a, &self.units);
         if let (ActuationSpec::InletTemperature { .. }, Some(th)) = (&self.spec.actuation, &mut self.thermal) {
             // Finite and within the spec's range by construction (see `step`).
             let _ = th.set_side_temperature(Edge::West, a[0]);
@@ -433,7 +437,10 @@ impl Env for LbmEnv {
             }
             self.actuate(&now);
             self.set_gust(self.time())?;
-            if let Err(e) = self.substep() {
+            let t = std::time::Instant::now();
+            let stepped = self.substep();
+            self.clock.stop(t);
+            if let Err(e) = stepped {
                 diverged = Some(e.to_string());
                 break;
             }
@@ -621,5 +628,11 @@ impl FamilySpec for EnvSpec {
 
     fn as_any(&self) -> &dyn std::any::Any {
         self
+    }
+}
+
+impl super::clock::SolverTime for LbmEnv {
+    fn solver_seconds(&self) -> f64 {
+        self.clock.seconds()
     }
 }

@@ -50,6 +50,7 @@ pub struct LbmEnv3 {
     a_old: Vec<f64>,
     actions_taken: usize,
     live: bool,
+    clock: super::clock::SolverClock,
     attractor: Option<Vec<f32>>,
     cache_dir: Option<PathBuf>,
     t0: u64,
@@ -182,6 +183,7 @@ impl LbmEnv3 {
             a_old: vec![0.0; act_dim],
             actions_taken: 0,
             live: false,
+            clock: Default::default(),
             attractor: None,
             cache_dir,
             t0: 0,
@@ -445,7 +447,10 @@ impl LbmEnv3 {
             }
             self.actuate(&now);
             self.set_gust(self.time())?;
-            self.substep()?;
+            let t = std::time::Instant::now();
+            let stepped = self.substep();
+            self.clock.stop(t);
+            stepped?;
             for (acc, f) in c.body.iter_mut().zip(self.solver.body_forces()) {
                 (0..3).for_each(|a| acc[a] += f[a] / self.force_scale / n as f64);
             }
@@ -756,5 +761,11 @@ impl FamilySpec for Env3Spec {
 
     fn as_any(&self) -> &dyn std::any::Any {
         self
+    }
+}
+
+impl super::clock::SolverTime for LbmEnv3 {
+    fn solver_seconds(&self) -> f64 {
+        self.clock.seconds()
     }
 }

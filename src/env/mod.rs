@@ -15,6 +15,7 @@ pub mod actuation;
 pub mod calibrate;
 pub mod cavity;
 pub mod channel;
+pub mod clock;
 pub mod cube;
 pub mod cylinder;
 pub mod family;

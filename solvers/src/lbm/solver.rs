@@ -667,6 +667,15 @@ impl D2q9 {
         }
     }
 
+    /// Sets the wall velocity of the listed links only (indices into [`D2q9::wall_points`]);
+    /// the others keep theirs.
+    pub fn set_link_velocities(&mut self, links: &[usize], mut velocity: impl FnMut(&WallPoint) -> [f64; 2]) {
+        for &l in links {
+            let u = velocity(&self.wall_points[l]);
+            self.links[l].uw = [u[0] as f32, u[1] as f32];
+        }
+    }
+
     /// Mass (lattice units) that the moving-wall terms of the Bouzidi rule inject into the fluid
     /// per step for `body`: `sum over links of 6 w_k rho_w c_k . u_w` (divided by `2q` where
     /// `q >= 1/2`), with `rho_w = 1`. Zero for a resting wall; zero to round-off for a
