@@ -43,6 +43,11 @@ impl EnvBenchRow {
     pub fn judged(&self) -> bool {
         self.level == Level::Coarse.name() && !self.id.contains("_3D_")
     }
+
+    /// Whether the row is judged and spends [`OUTSIDE_SHARE_TARGET`] or more outside the solver.
+    pub fn over_target(&self) -> bool {
+        self.judged() && self.outside_share >= OUTSIDE_SHARE_TARGET
+    }
 }
 
 /// The flow set-up and control interval of a lattice-Boltzmann spec (2D or 3D).
@@ -189,12 +194,12 @@ pub fn table(rows: &[EnvBenchRow]) -> String {
             1.0 / r.actions_per_s,
             r.mlups,
             100.0 * r.outside_share,
-            if r.judged() && r.outside_share >= OUTSIDE_SHARE_TARGET { "  <- over target" } else { "" }
+            if r.over_target() { "  <- over target" } else { "" }
         );
     }
     let judged: Vec<_> = rows.iter().filter(|r| r.judged()).collect();
     if !judged.is_empty() {
-        let met = judged.iter().filter(|r| r.outside_share < OUTSIDE_SHARE_TARGET).count();
+        let met = judged.iter().filter(|r| !r.over_target()).count();
         s += &format!(
             "outside the solver's steps (actuation, probes, forces, observation, reward, info): under {:.0} % of the action in {met} of {} 2D IDs at coarse\n",
             100.0 * OUTSIDE_SHARE_TARGET,

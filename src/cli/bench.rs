@@ -307,9 +307,7 @@ fn run_bench_envs(json: bool, actions: usize, quick: bool, families: Vec<String>
     } else {
         print!("{}", hgym::bench::envs::table(&rows));
     }
-    let over = rows
-        .iter()
-        .any(|r| r.judged() && r.outside_share >= hgym::bench::envs::OUTSIDE_SHARE_TARGET);
+    let over = rows.iter().any(|r| r.over_target());
     Ok(if over && !quick { Outcome::CheckFailed } else { Outcome::Ok })
 }
 

@@ -364,7 +364,10 @@ mod tests {
     #[test]
     fn setting_only_the_moving_links_changes_nothing() {
         let centers = [[3.0, 0.0], [4.5, 1.0], [4.5, -1.0]];
-        let bodies: Vec<_> = centers.iter().map(|&center| GeometrySpec::Circle { center, diameter: 1.0 }).collect();
+        let bodies: Vec<_> = centers
+            .iter()
+            .map(|&center| GeometrySpec::Circle { center, diameter: 1.0 })
+            .collect();
         let specs = [
             ActuationSpec::ZnmfJetsPerBody {
                 bodies: vec![1, 2],
@@ -386,7 +389,11 @@ mod tests {
             let on_rotors = moving.wall_points().iter().filter(|w| w.body != 0).count();
             match spec {
                 ActuationSpec::Rotation { .. } => assert_eq!(links.len(), on_rotors, "{spec:?}"),
-                _ => assert!(!links.is_empty() && links.len() < total / 4, "{} of {total} links move", links.len()),
+                _ => assert!(
+                    !links.is_empty() && links.len() < total / 4,
+                    "{} of {total} links move",
+                    links.len()
+                ),
             }
             for k in 0..20 {
                 let a = [0.05 * (k as f64 * 0.7).sin(), -0.03];
@@ -426,7 +433,10 @@ mod tests {
         let mut inside = 0;
         for i in -300..=300 {
             for j in -300..=300 {
-                let p = [jet.center[0] + i as f64 * jet.width / 250.0, jet.center[1] + j as f64 * jet.width / 250.0];
+                let p = [
+                    jet.center[0] + i as f64 * jet.width / 250.0,
+                    jet.center[1] + j as f64 * jet.width / 250.0,
+                ];
                 let (new, old) = (jet.profile(p), textbook(p));
                 assert_eq!(new.map(f64::to_bits), old.map(f64::to_bits), "at {p:?}");
                 inside += (old != [0.0, 0.0]) as usize;

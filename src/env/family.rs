@@ -12,8 +12,8 @@ use hgym_agents::{DifferentiableEnv, EnvError};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
-use super::fields::FlowFields;
 use super::clock::SolverTime;
+use super::fields::FlowFields;
 use super::EnvInputError;
 use crate::flow::Level;
 

@@ -172,7 +172,15 @@ impl LbmEnv {
 
     /// Sets the wall velocities for physical actuation `a` (units of U or U/D).
     fn actuate(&mut self, a: &[f64]) {
-        apply(&mut self.solver, &self.moving, &self.spec.actuation, &self.jets, &self.centers, a, &self.units);
+        apply(
+            &mut self.solver,
+            &self.moving,
+            &self.spec.actuation,
+            &self.jets,
+            &self.centers,
+            a,
+            &self.units,
+        );
         if let (ActuationSpec::InletTemperature { .. }, Some(th)) = (&self.spec.actuation, &mut self.thermal) {
             // Finite and within the spec's range by construction (see `step`).
             let _ = th.set_side_temperature(Edge::West, a[0]);

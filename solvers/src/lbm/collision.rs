@@ -411,7 +411,11 @@ mod tests {
                     }
                 }
                 let textbook = feq(i) + w(i) * 4.5 * qq;
-                assert!((g[i] as f64 - textbook).abs() < 2e-8, "omega {omega}, direction {i}: {} vs {textbook}", g[i]);
+                assert!(
+                    (g[i] as f64 - textbook).abs() < 2e-8,
+                    "omega {omega}, direction {i}: {} vs {textbook}",
+                    g[i]
+                );
             }
         }
     }
