@@ -11,6 +11,9 @@ env=${2:-Cylinder_3D_Re200}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export HGYM_CACHE="$work/cache"
+# Scratch folders of ranks go here, so that the check at the end sees this run's only.
+export TMPDIR="$work/tmp"
+mkdir -p "$TMPDIR"
 fail() { echo "MPI train check FAILED: $*"; exit 1; }
 # The curve without its wall-clock column.
 returns() { python3 -c 'import csv,sys; r=list(csv.DictReader(open(sys.argv[1]))); print([{k: v for k, v in row.items() if k != "wall_s"} for row in r])' "$1"; }
@@ -52,5 +55,5 @@ set -e
 [ $code = 2 ] || fail "two environments on two threads per rank exit with $code, not 2"
 echo "$err" | grep -q -- "--threads 1" || fail "the refusal of parallel environments does not name the fix: $err"
 echo "MPI train check: bad input and commands that do not run on ranks exit 2"
-ls "${TMPDIR:-/tmp}" | grep -q "^hgym-rank" && fail "a rank left its scratch folder in ${TMPDIR:-/tmp}"
+ls "$TMPDIR" | grep -q "^hgym-rank" && fail "a rank left its scratch folder ($(ls "$TMPDIR" | grep "^hgym-rank" | head -1))"
 exit 0

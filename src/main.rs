@@ -114,7 +114,7 @@ enum Outcome {
 fn main() -> ExitCode {
     // `hgym-mpi`: start MPI and learn this process's rank before anything prints (see `hgym::flow::ranks`).
     #[cfg(feature = "mpi")]
-    let _universe = {
+    let (_universe, ending) = {
         use mpi::traits::Communicator;
         // The solver is stepped from a worker thread, one call at a time.
         let Some((universe, provided)) = mpi::initialize_with_threading(mpi::Threading::Serialized) else {
@@ -129,8 +129,11 @@ fn main() -> ExitCode {
         }
         let world = universe.world();
         hgym::flow::ranks::set(world.rank() as usize, world.size() as usize);
-        universe
+        let ending = cli::ranks::Ending::new(&world);
+        (universe, ending)
     };
+    #[cfg(not(feature = "mpi"))]
+    let ending = cli::ranks::Ending;
     let mut cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
@@ -147,7 +150,7 @@ fn main() -> ExitCode {
     }
     let scratch = match cli::ranks::scatter_outputs(&mut cli.command) {
         Ok(s) => s,
-        Err(e) => return failed(e, None),
+        Err(e) => return failed(e, None, ending),
     };
     hgym::env::spin_up::observe_spin_ups(cli::progress::spin_up_progress);
     let result = match cli.command {
@@ -168,25 +171,20 @@ fn main() -> ExitCode {
     match result {
         Ok(Outcome::Ok) => ExitCode::SUCCESS,
         Ok(Outcome::CheckFailed) => ExitCode::from(1),
-        Err(e) => failed(e, scratch),
+        Err(e) => failed(e, scratch, ending),
     }
 }
 
 /// Reports `e` and ends: exit code 2 for bad input, else 1. On several MPI ranks every rank
-/// reports its own error and the job is aborted: ranks that did not fail would otherwise wait
-/// in the solver's next exchange for the one that did.
-fn failed(e: anyhow::Error, scratch: Option<cli::ranks::Scratch>) -> ExitCode {
+/// reports its own error and the job is aborted (see [`cli::ranks::Ending`]).
+fn failed(e: anyhow::Error, scratch: Option<cli::ranks::Scratch>, ending: cli::ranks::Ending) -> ExitCode {
     let code = if is_bad_input(&e) { 2 } else { 1 };
     match hgym::flow::ranks::rank() {
         (0, 1) => std::eprintln!("error: {e:#}"),
         (r, _) => std::eprintln!("error (rank {r}): {e:#}"),
     }
     drop(scratch);
-    #[cfg(feature = "mpi")]
-    if hgym::flow::ranks::rank().1 > 1 {
-        use mpi::traits::Communicator;
-        mpi::topology::SimpleCommunicator::world().abort(code);
-    }
+    ending.abort(code);
     ExitCode::from(code as u8)
 }
 

@@ -78,3 +78,53 @@ fn copy_dir(from: &Path, to: &Path) -> std::io::Result<()> {
     }
     Ok(())
 }
+
+/// How a failing rank ends an MPI job. Ranks that did not fail would wait in the solver's next
+/// exchange for the one that did, so the job is aborted; but an abort kills every rank at once,
+/// also one still on its way to removing its scratch folder. Bad input fails on every rank
+/// alike, so a failing rank first waits (at most [`Ending::GRACE`]) in a barrier of its own
+/// communicator, which only failing ranks enter: when all ranks fail, all have cleaned up before
+/// the abort; when some do not, the wait runs out and they are aborted as before.
+#[cfg(feature = "mpi")]
+pub struct Ending(mpi::topology::SimpleCommunicator);
+
+/// One process: nothing to end but itself.
+#[cfg(not(feature = "mpi"))]
+pub struct Ending;
+
+#[cfg(feature = "mpi")]
+impl Ending {
+    /// How long a failing rank waits for the others to fail too.
+    const GRACE: std::time::Duration = std::time::Duration::from_secs(5);
+
+    /// A collective: every rank calls it once, at start-up.
+    pub fn new(world: &mpi::topology::SimpleCommunicator) -> Self {
+        use mpi::traits::Communicator;
+        Self(world.duplicate())
+    }
+
+    /// Aborts the job with `code` once every rank failed or the grace time ran out (nothing on
+    /// one process).
+    pub fn abort(self, code: i32) {
+        use mpi::traits::{Communicator, CommunicatorCollectives};
+        if self.0.size() == 1 {
+            return;
+        }
+        let start = std::time::Instant::now();
+        let mut request = self.0.immediate_barrier();
+        while start.elapsed() < Self::GRACE {
+            match request.test() {
+                Ok(_) => break,
+                Err(pending) => request = pending,
+            }
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        self.0.abort(code)
+    }
+}
+
+#[cfg(not(feature = "mpi"))]
+impl Ending {
+    /// Nothing to abort.
+    pub fn abort(self, _code: i32) {}
+}
