@@ -70,8 +70,10 @@ class HgymEnv(gymnasium.Env):
 
     def step(self, action):
         """Applies ``action`` (finite, clipped to the box) for one control interval."""
-        a = np.ascontiguousarray(action, dtype=np.float64).reshape(-1)
-        return self._env.step(a)
+        try:  # a flat float32 or float64 array goes to Rust as it is
+            return self._env.step(action)
+        except TypeError:
+            return self._env.step(np.ascontiguousarray(action, dtype=np.float64).reshape(-1))
 
     def render(self):
         """The vorticity as an ``(height, width, 3)`` uint8 array (bodies grey), in

@@ -4,15 +4,17 @@
 //! Rust one (converted to float32 for Gymnasium's `Box`). The GIL is released while a solver
 //! steps; a vector environment steps its instances on Rust threads (rayon) in one call.
 
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
+use std::time::Instant;
 
 use hgym::env::{FlowEnv, Spec};
 use hgym::flow::Level;
 use hgym_agents::{EnvError, Info};
-use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyString};
 use rayon::prelude::*;
 
 /// A user's mistake (unknown ID, bad override, bad action) is a `ValueError`; a failure of the
@@ -46,26 +48,74 @@ fn spec(id: &str, overrides: Option<&str>) -> PyResult<Spec> {
     spec.with_overrides(&table).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
-/// `f` with the GIL released, on a worker of rayon's pool (where `hgym train` steps its
-/// environments): a solver's parallel loops then start inside the pool instead of each handing
-/// its work over from Python's thread and waiting for it; one hand-over per call remains.
-fn detached<R: Send>(py: Python<'_>, f: impl FnOnce() -> R + Send) -> R {
-    py.detach(|| rayon::scope(|_| f()))
+/// `f` with the GIL released, inside this thread's own rayon pool, of which the calling thread
+/// is worker 0 (`use_current_thread`) and which has as many threads as rayon's global pool
+/// (`RAYON_NUM_THREADS`): `f` runs right here, with no hand-over to another thread and back
+/// (two thread wake-ups, tens of microseconds, which a small flow's whole step can cost), and a
+/// solver's parallel loops inside `f` start within the pool as they do under `hgym train`.
+fn detached<R: Send>(py: Python<'_>, f: impl FnOnce() -> R + Send) -> PyResult<R> {
+    thread_local! {
+        static POOL: std::cell::OnceCell<Result<rayon::ThreadPool, String>> = const { std::cell::OnceCell::new() };
+    }
+    py.detach(|| {
+        POOL.with(|pool| {
+            let pool = pool.get_or_init(|| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(rayon::current_num_threads())
+                    .use_current_thread()
+                    .build()
+                    .map_err(|e| format!("cannot start hgym's worker threads: {e}"))
+            });
+            match pool {
+                Ok(pool) => Ok(pool.install(f)),
+                Err(e) => Err(PyRuntimeError::new_err(e.clone())),
+            }
+        })
+    })
 }
 
 fn make(spec: &Spec, level: Level) -> PyResult<Box<dyn FlowEnv>> {
     spec.make(level, hgym::env::default_cache_dir()).map_err(env_error)
 }
 
-fn info_dict<'py>(py: Python<'py>, info: &Info) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    for (k, v) in &info.values {
-        d.set_item(k, *v)?;
+/// The info keys as Python strings, made once: an environment reports the same keys every
+/// step, and a new string per key and step (allocated, checked, hashed) is most of what building
+/// the info dict costs.
+#[derive(Default)]
+struct InfoKeys(Mutex<Vec<(String, Py<PyString>)>>);
+
+impl InfoKeys {
+    /// `info` as a Python dict (numbers as float, texts as str).
+    fn dict<'py>(&self, py: Python<'py>, info: &Info) -> PyResult<Bound<'py, PyDict>> {
+        let mut keys = self
+            .0
+            .lock()
+            .map_err(|_| PyRuntimeError::new_err("the info keys were poisoned by an earlier failure"))?;
+        let d = PyDict::new(py);
+        let mut i = 0;
+        for (k, v) in &info.values {
+            d.set_item(Self::key(&mut keys, py, i, k), *v)?;
+            i += 1;
+        }
+        for (k, v) in &info.text {
+            d.set_item(Self::key(&mut keys, py, i, k), v)?;
+            i += 1;
+        }
+        Ok(d)
     }
-    for (k, v) in &info.text {
-        d.set_item(k, v)?;
+
+    /// The `i`-th key, `name`: the string kept from an earlier call if it is the same.
+    fn key<'py>(keys: &mut Vec<(String, Py<PyString>)>, py: Python<'py>, i: usize, name: &str) -> Bound<'py, PyString> {
+        match keys.get(i) {
+            Some((kept, k)) if kept == name => k.bind(py).clone(),
+            _ => {
+                let k = PyString::new(py, name);
+                keys.truncate(i);
+                keys.push((name.to_string(), k.clone().unbind()));
+                k
+            }
+        }
     }
-    Ok(d)
 }
 
 /// An observation (float32), `(low, high)` of a space, and the infos of a vector step.
@@ -87,6 +137,10 @@ struct Env {
     env: Mutex<Box<dyn FlowEnv>>,
     spec: Spec,
     level: Level,
+    /// Nanoseconds spent inside `FlowEnv::step` over every `step` call, so that the boundary's
+    /// own cost (the rest of the call) can be measured on the same calls.
+    step_ns: AtomicU64,
+    keys: InfoKeys,
 }
 
 impl Env {
@@ -110,6 +164,8 @@ impl Env {
             env: Mutex::new(env),
             spec,
             level: lvl,
+            step_ns: AtomicU64::new(0),
+            keys: InfoKeys::default(),
         })
     }
 
@@ -127,6 +183,13 @@ impl Env {
     #[getter]
     fn spec_toml(&self) -> String {
         self.spec.to_toml()
+    }
+
+    /// Seconds spent inside the Rust environment's `step` over all `step` calls so far (what a
+    /// call costs beyond it is the Python boundary; `hgym bench python` reads it).
+    #[getter]
+    fn step_seconds(&self) -> f64 {
+        self.step_ns.load(Ordering::Relaxed) as f64 * 1e-9
     }
 
     #[getter]
@@ -158,22 +221,52 @@ impl Env {
     fn reset<'py>(&self, py: Python<'py>, seed: u64) -> PyResult<(Obs<'py>, Bound<'py, PyDict>)> {
         let mut guard = self.env()?;
         let env: &mut dyn FlowEnv = &mut **guard;
-        let (obs, info) = detached(py, || env.reset(seed)).map_err(env_error)?;
-        Ok((obs_array(py, &obs), info_dict(py, &info)?))
+        let (obs, info) = detached(py, || env.reset(seed))?.map_err(env_error)?;
+        Ok((obs_array(py, &obs), self.keys.dict(py, &info)?))
     }
 
-    /// `step(action) -> (obs, reward, terminated, truncated, info)`; `action` a float64 vector.
+    /// `step(action) -> (obs, reward, terminated, truncated, info)`; `action` a contiguous 1-D
+    /// numpy array of float64, or of float32 (what Gymnasium's `Box` samples; widened exactly).
+    /// Anything else is a `TypeError`, which `HgymEnv.step` answers by converting.
     #[allow(clippy::type_complexity)]
     fn step<'py>(
         &self,
         py: Python<'py>,
-        action: PyReadonlyArray1<'py, f64>,
+        action: &Bound<'py, PyAny>,
     ) -> PyResult<(Bound<'py, PyArray1<f32>>, f64, bool, bool, Bound<'py, PyDict>)> {
-        let action = action.as_slice().map_err(|e| PyValueError::new_err(format!("the action: {e}")))?;
+        let not_flat = |e: numpy::AsSliceError| PyTypeError::new_err(format!("the action: {e}"));
+        let (doubles, singles, widened);
+        let action: &[f64] = if let Ok(a) = action.cast::<PyArray1<f64>>() {
+            doubles = a.readonly();
+            doubles.as_slice().map_err(not_flat)?
+        } else if let Ok(a) = action.cast::<PyArray1<f32>>() {
+            singles = a.readonly();
+            widened = singles
+                .as_slice()
+                .map_err(not_flat)?
+                .iter()
+                .map(|&v| f64::from(v))
+                .collect::<Vec<_>>();
+            &widened
+        } else {
+            return Err(PyTypeError::new_err("the action must be a 1-D numpy array of float32 or float64"));
+        };
         let mut guard = self.env()?;
         let env: &mut dyn FlowEnv = &mut **guard;
-        let r = detached(py, || env.step(action)).map_err(env_error)?;
-        Ok((obs_array(py, &r.obs), r.reward, r.terminated, r.truncated, info_dict(py, &r.info)?))
+        let (r, ns) = detached(py, || {
+            let t = Instant::now();
+            let r = env.step(action);
+            (r, t.elapsed().as_nanos() as u64)
+        })?;
+        self.step_ns.fetch_add(ns, Ordering::Relaxed);
+        let r = r.map_err(env_error)?;
+        Ok((
+            obs_array(py, &r.obs),
+            r.reward,
+            r.terminated,
+            r.truncated,
+            self.keys.dict(py, &r.info)?,
+        ))
     }
 
     /// The vorticity (for a flow without one, its first snapshot field: the channels' wall shear
@@ -226,7 +319,7 @@ impl Env {
     fn reward_action_gradients<'py>(&self, py: Python<'py>, k: usize) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let mut guard = self.env()?;
         let env: &mut dyn FlowEnv = &mut **guard;
-        let g = detached(py, || env.reward_action_gradients(k)).map_err(env_error)?;
+        let g = detached(py, || env.reward_action_gradients(k))?.map_err(env_error)?;
         PyArray2::from_vec2(py, &g).map_err(|e| PyRuntimeError::new_err(e.to_string()))
     }
 }
@@ -238,6 +331,7 @@ impl Env {
 struct VecEnv {
     envs: Mutex<Vec<Box<dyn FlowEnv>>>,
     spec: Spec,
+    keys: InfoKeys,
 }
 
 impl VecEnv {
@@ -270,6 +364,7 @@ impl VecEnv {
         Ok(VecEnv {
             envs: Mutex::new(envs),
             spec,
+            keys: InfoKeys::default(),
         })
     }
 
@@ -299,10 +394,10 @@ impl VecEnv {
                 .zip(seeds.par_iter())
                 .map(|(e, &s)| e.reset(s))
                 .collect::<Result<Vec<_>, _>>()
-        })
+        })?
         .map_err(env_error)?;
         let obs = out.iter().map(|(o, _)| o.as_slice());
-        let infos = out.iter().map(|(_, i)| info_dict(py, i)).collect::<PyResult<_>>()?;
+        let infos = out.iter().map(|(_, i)| self.keys.dict(py, i)).collect::<PyResult<_>>()?;
         Ok((matrix(py, obs, self.spec.obs_dim())?, infos))
     }
 
@@ -353,9 +448,9 @@ impl VecEnv {
                     None => e.step(a),
                 })
                 .collect::<Result<Vec<_>, _>>()
-        })
+        })?
         .map_err(env_error)?;
-        let infos = out.iter().map(|r| info_dict(py, &r.info)).collect::<PyResult<_>>()?;
+        let infos = out.iter().map(|r| self.keys.dict(py, &r.info)).collect::<PyResult<_>>()?;
         Ok((
             matrix(py, out.iter().map(|r| r.obs.as_slice()), self.spec.obs_dim())?,
             out.iter().map(|r| r.reward).collect(),

@@ -127,6 +127,28 @@ def test_the_vector_env_autoresets_on_the_next_step():
     assert obs.shape == vec.observation_space.shape
 
 
+def test_every_action_form_steps_bitwise_alike():
+    """float32 and float64 arrays go to Rust as they are (float32 widened exactly); lists,
+    strided arrays and other shapes are converted by `HgymEnv.step`: all give one trajectory."""
+    a64 = np.random.default_rng(1).uniform(-1, 1, (3, 4)).astype(np.float32).astype(np.float64)
+    forms = [
+        lambda a: a,
+        lambda a: a.astype(np.float32),
+        lambda a: a.tolist(),
+        lambda a: np.repeat(a, 2)[::2],
+        lambda a: a.reshape(1, -1),
+    ]
+    runs = []
+    for form in forms:
+        env = hgym.HgymEnv("Kolmogorov_2D_Re40", episode_actions=3)
+        env.reset(seed=5)
+        before = env._env.step_seconds
+        runs.append([env.step(form(a))[0] for a in a64])
+        assert env._env.step_seconds > before
+    for run in runs[1:]:
+        assert all(np.array_equal(x, y) for x, y in zip(runs[0], run))
+
+
 def test_errors_arrive_with_the_rust_message():
     with pytest.raises(ValueError, match="did you mean 'Cylinder_2D_Re100'"):
         hgym.HgymEnv("Cylindr_2D_Re100")

@@ -8,10 +8,11 @@ A line protocol on stdin/stdout (the one `hgym bench kolmogorov --peer` speaks):
                                       makes `hgym.HgymEnv(ID, LEVEL, **OVERRIDES)` (OVERRIDES a JSON
                                       object without spaces) and `gymnasium.make` of the same, and
                                       resets both with SEED
-    steps N                        -> {"s_per_step": ..., "s_per_step_gym": ...}
+    steps N                        -> {"s_per_step": ..., "s_in_rust": ..., "s_per_step_gym": ..., "s_in_rust_gym": ...}
                                       N zero actions through `HgymEnv.step` (the boundary: numpy in,
                                       numpy and a dict out, the GIL released), then N through
-                                      `gymnasium.make`'s wrappers (Gymnasium's own checks, for scale)
+                                      `gymnasium.make`'s wrappers (Gymnasium's own checks, for scale);
+                                      each with the seconds per step spent inside the Rust step
     vec N ID LEVEL SEED OVERRIDES  -> {"num_envs": N}: `hgym.make_vec`, reset with SEED
     vsteps K                       -> {"env_steps_per_s": ...}: K steps of the vector env
     action                         -> {"s_per_action": ...}: one action of the last `env`
@@ -70,14 +71,14 @@ def main():
             out = {"obs_dim": int(env.observation_space.shape[0]), "act_dim": int(zero.shape[0])}
         elif cmd == "steps":
             n = int(words[1])
-            t = time.perf_counter()
-            for _ in range(n):
-                env.step(zero)
-            s = (time.perf_counter() - t) / n
-            t = time.perf_counter()
-            for _ in range(n):
-                wrapped.step(zero)
-            out = {"s_per_step": s, "s_per_step_gym": (time.perf_counter() - t) / n}
+            out = {}
+            for key, e, inner in [("", env, env._env), ("_gym", wrapped, wrapped.unwrapped._env)]:
+                inside = inner.step_seconds
+                t = time.perf_counter()
+                for _ in range(n):
+                    e.step(zero)
+                out["s_per_step" + key] = (time.perf_counter() - t) / n
+                out["s_in_rust" + key] = (inner.step_seconds - inside) / n
         elif cmd == "vec":
             n, env_id, level, seed, overrides = int(words[1]), words[2], words[3], int(words[4]), json.loads(words[5])
             vec = hgym.make_vec(env_id, n, level=level, **overrides)

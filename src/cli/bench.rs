@@ -74,9 +74,9 @@ pub enum BenchCommand {
     /// step stated. Exit 1 if that ratio is below 5x; 2 if --peer is given and the peers are not
     /// installed.
     Channel(#[command(flatten)] PeerBenchArgs),
-    /// hgym from Python: the boundary's overhead per step (HgymEnv.step against the same env
-    /// stepped in Rust, alternating) and the vector env's throughput against the Rust loop, 1 and
-    /// 2 threads. Needs the package (`make python`; the interpreter is $HGYM_PYTHON, else
+    /// hgym from Python: the boundary's overhead per step (HgymEnv.step minus the Rust step inside
+    /// the same calls; beside it the same env stepped in a Rust loop, alternating) and the vector
+    /// env's throughput against the Rust loop, 1 and 2 threads. Needs the package (`make python`; the interpreter is $HGYM_PYTHON, else
     /// ~/.cache/hgym-venv/bin/python). With --peer, HydroGym's JAX Kolmogorov env through its
     /// Gymnasium wrapper beside hgym's, per control action. Exit 1 if the overhead is 5 us or more
     /// or the vector env reaches less than 95 % of the Rust loop.

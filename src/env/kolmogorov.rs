@@ -339,6 +339,9 @@ pub struct KolmogorovEnv {
     theta: f64,
     tke_ref: f64,
     obs_scale: f64,
+    /// The velocity fields the probes read, reused every step.
+    u: Vec<f64>,
+    v: Vec<f64>,
 }
 
 impl KolmogorovEnv {
@@ -372,6 +375,8 @@ impl KolmogorovEnv {
             history: vec![],
             live: false,
             clock: Default::default(),
+            u: vec![0.0; n * n],
+            v: vec![0.0; n * n],
         })
     }
 
@@ -419,8 +424,8 @@ impl KolmogorovEnv {
     }
 
     fn observation(&mut self) -> Vec<f64> {
-        let (u, v) = self.solver.velocity();
-        let n = self.solver.n();
+        self.solver.velocity_into(&mut self.u, &mut self.v);
+        let (u, v, n) = (&self.u, &self.v, self.solver.n());
         let p = self.spec.probes_per_side;
         let stride = n / p;
         let mut obs = Vec::with_capacity(2 * p * p);

@@ -264,16 +264,22 @@ impl Kolmogorov {
     pub fn velocity(&mut self) -> (Vec<f64>, Vec<f64>) {
         let m = self.n * self.n;
         let (mut u, mut v) = (vec![0.0; m], vec![0.0; m]);
+        self.velocity_into(&mut u, &mut v);
+        (u, v)
+    }
+
+    /// [`Kolmogorov::velocity`] into `u` and `v` (`n * n` each) from the stream function,
+    /// `u_hat = i k_y omega_hat / k^2`, `v_hat = -i k_x omega_hat / k^2`; allocates nothing.
+    pub fn velocity_into(&mut self, u: &mut [f64], v: &mut [f64]) {
         let s = &mut self.w.spec[0];
         for i in 0..self.len {
             s[i] = self.omega[i] * C::new(0.0, self.ky[i] * self.inv_k2[i]);
         }
-        self.fft.inverse(s, &mut u);
+        self.fft.inverse(s, u);
         for i in 0..self.len {
             s[i] = self.omega[i] * C::new(0.0, -self.kx[i] * self.inv_k2[i]);
         }
-        self.fft.inverse(s, &mut v);
-        (u, v)
+        self.fft.inverse(s, v);
     }
 
     /// Energy dissipation rate per unit area, `epsilon = 2 nu <S_ij S_ij> = nu <omega^2>` (equal on a
