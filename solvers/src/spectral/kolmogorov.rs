@@ -93,7 +93,7 @@ struct Work {
     s: Vec<C>,
     forcing: Vec<C>,
     stage: [Fields; 4],
-    bar: [Vec<C>; 6],
+    bar: [Vec<C>; 5],
     fbar: Vec<C>,
     mu: Vec<f64>,
 }
@@ -201,7 +201,7 @@ impl Kolmogorov {
                 s: z(),
                 forcing: z(),
                 stage: [Fields::new(m), Fields::new(m), Fields::new(m), Fields::new(m)],
-                bar: [z(), z(), z(), z(), z(), z()],
+                bar: [z(), z(), z(), z(), z()],
                 fbar: z(),
                 mu: vec![0.0; m],
             },
@@ -395,7 +395,9 @@ impl Kolmogorov {
     }
 
     /// The four stages of Lawson RK4 from `w0` into `w1`; stage fields stay in the work arrays.
-    fn stages(&mut self, w0: &[C], w1: &mut [C]) {
+    /// Without `w1` (a VJP's recomputation, which needs only the stage fields) the last stage's
+    /// transform back to spectral space and the update are skipped.
+    fn stages(&mut self, w0: &[C], w1: Option<&mut [C]>) {
         let h = self.cfg.dt;
         self.rhs(w0, 0, 0);
         let mut s = std::mem::take(&mut self.w.s);
@@ -411,6 +413,11 @@ impl Kolmogorov {
         for i in 0..a {
             s[i] = self.e_full[i] * w0[i] + self.e_half[i] * self.w.k[2][i] * h;
         }
+        let Some(w1) = w1 else {
+            self.fields(&s, 3);
+            self.w.s = s;
+            return;
+        };
         self.rhs(&s, 3, 3);
         self.w.s = s;
         let k = &self.w.k;
@@ -426,7 +433,7 @@ impl Kolmogorov {
         self.set_forcing(a)?;
         let w0 = std::mem::take(&mut self.omega);
         let mut w1 = std::mem::take(&mut self.w.bar[0]);
-        self.stages(&w0, &mut w1);
+        self.stages(&w0, Some(&mut w1));
         self.w.bar[0] = w0;
         self.omega = w1;
         self.steps += 1;
@@ -485,12 +492,10 @@ impl Kolmogorov {
     /// from `w0` (the solver's own state is not touched).
     pub fn step_vjp(&mut self, w0: &[C], a: &[f64], bar1: &[C], bar0: &mut [C], bar_a: &mut [f64]) -> Result<(), SpectralError> {
         self.set_forcing(a)?;
-        let mut w1 = std::mem::take(&mut self.w.bar[5]);
-        w1.resize(self.len, C::default());
-        self.stages(w0, &mut w1);
-        self.w.bar[5] = w1;
-        let h = self.cfg.dt;
-        // Cotangents of k1..k4, of a stage state, and of the forcing.
+        self.stages(w0, None);
+        let (h, act) = (self.cfg.dt, self.act);
+        // Cotangents of k1..k4, of a stage state, and of the forcing, on the dealiased modes
+        // (the only ones a step reads or writes).
         let mut kb: [Vec<C>; 4] = std::array::from_fn(|j| std::mem::take(&mut self.w.bar[j]));
         for v in kb.iter_mut() {
             v.resize(self.len, C::default());
@@ -499,7 +504,7 @@ impl Kolmogorov {
         sb.resize(self.len, C::default());
         let mut fbar = std::mem::take(&mut self.w.fbar);
         fbar.iter_mut().for_each(|c| *c = C::default());
-        for i in 0..self.len {
+        for i in 0..act {
             let (e, e2, g) = (self.e_full[i], self.e_half[i], bar1[i]);
             kb[0][i] = g * (e * h / 6.0);
             kb[1][i] = g * (e2 * h / 3.0);
@@ -509,31 +514,32 @@ impl Kolmogorov {
         }
         // k4 = N(s4) + F, s4 = E w0 + h E/2 k3
         self.nonlinear_vjp(3, &kb[3], &mut sb);
-        for i in 0..self.len {
+        for i in 0..act {
             fbar[i] += kb[3][i];
             bar0[i] += sb[i] * self.e_full[i];
             kb[2][i] += sb[i] * (h * self.e_half[i]);
         }
         // k3 = N(s3) + F, s3 = E/2 w0 + h/2 k2
         self.nonlinear_vjp(2, &kb[2], &mut sb);
-        for i in 0..self.len {
+        for i in 0..act {
             fbar[i] += kb[2][i];
             bar0[i] += sb[i] * self.e_half[i];
             kb[1][i] += sb[i] * (h / 2.0);
         }
         // k2 = N(s2) + F, s2 = E/2 (w0 + h/2 k1)
         self.nonlinear_vjp(1, &kb[1], &mut sb);
-        for i in 0..self.len {
+        for i in 0..act {
             fbar[i] += kb[1][i];
             bar0[i] += sb[i] * self.e_half[i];
             kb[0][i] += sb[i] * (h / 2.0 * self.e_half[i]);
         }
         // k1 = N(w0) + F
         self.nonlinear_vjp(0, &kb[0], &mut sb);
-        for i in 0..self.len {
+        for i in 0..act {
             fbar[i] += kb[0][i];
             bar0[i] = (bar0[i] + sb[i]) * self.mask[i];
         }
+        bar0[act..].iter_mut().for_each(|c| *c = C::default());
         for (ba, phi) in bar_a.iter_mut().zip(&self.controls) {
             *ba += inner(phi, &fbar, self.n);
         }
@@ -549,7 +555,7 @@ impl Kolmogorov {
     /// segment of a trajectory in a backward sweep).
     pub fn step_from(&mut self, w: &[C], a: &[f64], out: &mut [C]) -> Result<(), SpectralError> {
         self.set_forcing(a)?;
-        self.stages(w, out);
+        self.stages(w, Some(out));
         Ok(())
     }
 }
