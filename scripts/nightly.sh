@@ -68,6 +68,9 @@ total=$(( $(date +%s) - start ))
     if grep -qE "^  FAIL " "$OUT"/validate-kolmogorov.txt; then echo "kolmogorov_re40 FAIL"; fi
   )
   echo "${failing:-(none)}"
+  echo
+  # The long results nightly leaves alone, and how far the code has moved since each was made.
+  python3 scripts/results_age.py results
 } > "$OUT/summary.md"
 cat "$OUT/summary.md"
 exit "$failed"
