@@ -21,7 +21,7 @@
 use realfft::num_complex::Complex64 as C;
 use thiserror::Error;
 
-use super::fft2::{inner, ky_of, Fft2};
+use super::fft2::{inner, inverse_destroying_split, ky_of, Fft2};
 
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SpectralError {
@@ -457,7 +457,7 @@ impl Kolmogorov {
         for i in 0..self.act {
             s[i] = lambda[i] * self.mask[i];
         }
-        self.fft.inverse_destroying(s, &mut self.w.mu);
+        inverse_destroying_split(&mut self.fft, &mut self.fft_b, s, &mut self.w.mu, rayon::current_num_threads() > 1);
         let f = &self.w.stage[slot];
         let [s0, s1, s2, s3] = &mut self.w.spec;
         let (fa, fb) = (&mut self.fft, &mut self.fft_b);
