@@ -73,6 +73,14 @@ fn join(a: impl FnOnce() + Send, b: impl FnOnce() + Send) {
     }
 }
 
+/// Row `y` of the product `a b` of two `n x n` fields, for [`Fft2::forward_rows`].
+fn product_rows<'a>(a: &'a [f64], b: &'a [f64], n: usize) -> impl FnMut(usize, &mut [f64]) + 'a {
+    move |y, row| {
+        let r = y * n..(y + 1) * n;
+        row.iter_mut().zip(&a[r.clone()]).zip(&b[r]).for_each(|((p, a), b)| *p = a * b);
+    }
+}
+
 impl Fields {
     fn new(m: usize) -> Self {
         Fields {
@@ -87,8 +95,6 @@ impl Fields {
 /// Reused work arrays: nothing is allocated by a step.
 struct Work {
     spec: [Vec<C>; 4],
-    prod: Vec<f64>,
-    prod_b: Vec<f64>,
     k: [Vec<C>; 4],
     s: Vec<C>,
     forcing: Vec<C>,
@@ -195,8 +201,6 @@ impl Kolmogorov {
             steps: 0,
             w: Work {
                 spec: [z(), z(), z(), z()],
-                prod: vec![0.0; m],
-                prod_b: vec![0.0; m],
                 k: [z(), z(), z(), z()],
                 s: z(),
                 forcing: z(),
@@ -368,11 +372,18 @@ impl Kolmogorov {
     fn rhs(&mut self, w: &[C], slot: usize, out_slot: usize) {
         self.fields(w, slot);
         let f = &self.w.stage[slot];
-        for (((p, u), v), (wx, wy)) in self.w.prod.iter_mut().zip(&f.u).zip(&f.v).zip(f.wx.iter().zip(&f.wy)) {
-            *p = u * wx + v * wy;
-        }
         let out = &mut self.w.k[out_slot];
-        self.fft.forward_destroying(&mut self.w.prod, out);
+        let n = self.n;
+        self.fft.forward_rows(
+            |y, row| {
+                let r = y * n..(y + 1) * n;
+                let (u, v, wx, wy) = (&f.u[r.clone()], &f.v[r.clone()], &f.wx[r.clone()], &f.wy[r]);
+                for ((((p, u), v), wx), wy) in row.iter_mut().zip(u).zip(v).zip(wx).zip(wy) {
+                    *p = u * wx + v * wy;
+                }
+            },
+            out,
+        );
         for ((o, m), fc) in out[..self.act].iter_mut().zip(&self.mask).zip(&self.w.forcing) {
             *o = -*o * *m + *fc;
         }
@@ -461,21 +472,16 @@ impl Kolmogorov {
         let f = &self.w.stage[slot];
         let [s0, s1, s2, s3] = &mut self.w.spec;
         let (fa, fb) = (&mut self.fft, &mut self.fft_b);
-        let (pa, pb) = (&mut self.w.prod, &mut self.w.prod_b);
-        let mu = &self.w.mu;
-        let product = |p: &mut Vec<f64>, a: &[f64]| p.iter_mut().zip(a).zip(mu).for_each(|((p, a), b)| *p = a * b);
+        let (mu, n) = (&self.w.mu, self.n);
+        let product = |a| product_rows(a, mu, n);
         join(
             || {
-                product(pa, &f.wx);
-                fa.forward_destroying(pa, s1);
-                product(pa, &f.u);
-                fa.forward_destroying(pa, s2);
+                fa.forward_rows(product(&f.wx), s1);
+                fa.forward_rows(product(&f.u), s2);
             },
             || {
-                product(pb, &f.wy);
-                fb.forward_destroying(pb, s3);
-                product(pb, &f.v);
-                fb.forward_destroying(pb, s0);
+                fb.forward_rows(product(&f.wy), s3);
+                fb.forward_rows(product(&f.v), s0);
             },
         );
         for i in 0..self.act {
