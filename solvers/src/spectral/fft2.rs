@@ -70,44 +70,14 @@ impl Fft2 {
 
     /// `out = FFT2(phys)`; columns beyond `active` are set to zero.
     pub fn forward(&mut self, phys: &[f64], out: &mut [Complex64]) {
-        let (n, nh) = (self.n, self.nh);
+        let n = self.n;
         assert_eq!(phys.len(), n * n);
-        assert_eq!(out.len(), n * nh);
-        for y in 0..n {
-            self.row.copy_from_slice(&phys[y * n..(y + 1) * n]);
-            // Lengths match the plan, so the transform cannot fail.
-            let _ = self
-                .r2c
-                .process_with_scratch(&mut self.row, &mut self.row_spec, &mut self.scratch_r);
-            for kx in 0..self.active {
-                out[kx * n + y] = self.row_spec[kx];
-            }
-        }
-        out[self.active * n..].iter_mut().for_each(|c| *c = Complex64::default());
-        self.fwd.process_with_scratch(&mut out[..self.active * n], &mut self.scratch_c);
-    }
-
-    /// [`Fft2::forward`] that uses `phys` as its work array (its content is destroyed).
-    pub fn forward_destroying(&mut self, phys: &mut [f64], out: &mut [Complex64]) {
-        let (n, nh) = (self.n, self.nh);
-        assert_eq!(phys.len(), n * n);
-        assert_eq!(out.len(), n * nh);
-        for y in 0..n {
-            // Lengths match the plan, so the transform cannot fail.
-            let _ = self
-                .r2c
-                .process_with_scratch(&mut phys[y * n..(y + 1) * n], &mut self.row_spec, &mut self.scratch_r);
-            for kx in 0..self.active {
-                out[kx * n + y] = self.row_spec[kx];
-            }
-        }
-        out[self.active * n..].iter_mut().for_each(|c| *c = Complex64::default());
-        self.fwd.process_with_scratch(&mut out[..self.active * n], &mut self.scratch_c);
+        self.forward_rows(|y, row| row.copy_from_slice(&phys[y * n..(y + 1) * n]), out);
     }
 
     /// `out = FFT2(f)` of the field whose row `y` `fill(y, row)` writes (`row` has `n` values):
     /// a product of fields is transformed row by row as it is formed, with no `n x n` array
-    /// written and read back in between. Bitwise [`Fft2::forward`] of the same field.
+    /// written and read back in between.
     pub fn forward_rows(&mut self, mut fill: impl FnMut(usize, &mut [f64]), out: &mut [Complex64]) {
         let (n, nh) = (self.n, self.nh);
         assert_eq!(out.len(), n * nh);
