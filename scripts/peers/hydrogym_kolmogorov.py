@@ -74,7 +74,7 @@ def main():
     key = jax.random.PRNGKey(0)
     zero = jnp.zeros(4)
     grids = {64: developed(64)}
-    params, step, state = grids[64]["params"], grids[64]["step"], grids[64]["state"]
+    params = grids[64]["params"]
     gym_env = None
     for line in sys.stdin:
         words = line.split()
@@ -100,8 +100,6 @@ def main():
             jax.block_until_ready(g["state"].omega_hat)
             wall = time.perf_counter() - t
             out = {"steps_per_s": g["steps"] / wall, "s_per_action": wall, "steps": g["steps"], "n": n}
-            if n == 64:
-                state = g["state"]
         elif words[0] == "gym_action":
             if gym_env is None:
                 # A fresh env: the wrapper deep-copies it, and `env` holds tracers from `step`'s jit.
@@ -114,6 +112,7 @@ def main():
             out = {"s_per_action": time.perf_counter() - t}
         elif words[0] == "accuracy":
             _, _, fine_step = make(DT / 4)
+            step, state = grids[64]["step"], grids[64]["state"]
             a = step(key, state, zero).omega_hat
             b = fine_step(key, state, zero).omega_hat
             err = float(jnp.linalg.norm(a - b) / jnp.linalg.norm(b))

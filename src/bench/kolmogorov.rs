@@ -194,7 +194,7 @@ pub fn bench_kolmogorov(quick: bool, peer: Option<&mut Peer>) -> Result<Kolmogor
     let threads = rayon::current_num_threads();
     let fast_enough = peer.as_ref().is_none_or(|p| p.fast_enough(threads));
     Ok(KolmogorovBench {
-        pass: sizes.iter().all(|s| s.vjp_over_step <= VJP_TARGET) && fast_enough,
+        pass: vjp_within_target(&sizes) && fast_enough,
         threads,
         sizes,
         accuracy,
@@ -241,6 +241,11 @@ fn with_peer(p: &mut Peer, quick: bool, w0: &[C], our_dt: f64) -> Result<Kolmogo
     })
 }
 
+/// Whether a step's VJP costs at most [`VJP_TARGET`] forward steps at every size.
+fn vjp_within_target(sizes: &[SizeRow]) -> bool {
+    sizes.iter().all(|s| s.vjp_over_step <= VJP_TARGET)
+}
+
 impl KolmogorovPeer {
     /// Whether our steps/s are at least [`speedup_target`] times the peer's on every grid.
     pub fn fast_enough(&self, threads: usize) -> bool {
@@ -264,7 +269,7 @@ pub fn table(b: &KolmogorovBench) -> String {
     for a in &b.accuracy {
         s += &format!("{:8.4} {:15.2e} {:14.4}\n", a.dt, a.relative_error, a.s_per_action);
     }
-    let vjp_ok = b.sizes.iter().all(|s| s.vjp_over_step <= VJP_TARGET);
+    let vjp_ok = vjp_within_target(&b.sizes);
     s += &format!(
         "largest dt within {:.1e}: {} -> {:.4} s per action\nVJP within {VJP_TARGET}x a step: {}\n",
         b.tolerance,
