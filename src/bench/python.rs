@@ -288,15 +288,27 @@ fn vector_row(
     let mut step_all = || envs.par_iter_mut().try_for_each(|e| e.step(&zero).map(|_| ()));
     let t = Instant::now();
     step_all()?;
-    let k = ((if quick { 0.1 } else { 0.5 }) / t.elapsed().as_secs_f64()).clamp(2.0, 10_000.0) as usize;
+    let k = ((if quick { 0.1 } else { 0.25 }) / t.elapsed().as_secs_f64()).clamp(2.0, 10_000.0) as usize;
     let mut pairs = vec![];
-    for _ in 0..rounds {
-        let t = Instant::now();
-        for _ in 0..k {
-            step_all()?;
-        }
-        let rust = (k * n) as f64 / t.elapsed().as_secs_f64();
-        let [python] = py.numbers(&format!("vsteps {k}"), ["env_steps_per_s"])?;
+    // The machine's speed moves by tens of percent within seconds, so the ratio needs many short
+    // pairs, and each pair's order alternates (Rust first, then Python first) so that a drift
+    // within a pair does not favour either side.
+    for round in 0..3 * rounds {
+        let mut rust_loop = || -> Result<f64, PythonBenchError> {
+            let t = Instant::now();
+            for _ in 0..k {
+                step_all()?;
+            }
+            Ok((k * n) as f64 / t.elapsed().as_secs_f64())
+        };
+        let python_loop = |py: &mut Peer| py.numbers(&format!("vsteps {k}"), ["env_steps_per_s"]).map(|[p]| p);
+        let (rust, python) = if round % 2 == 0 {
+            let rust = rust_loop()?;
+            (rust, python_loop(py)?)
+        } else {
+            let python = python_loop(py)?;
+            (rust_loop()?, python)
+        };
         // Python over Rust: the vector env's share of the Rust loop's throughput.
         pairs.push((python, rust));
     }
