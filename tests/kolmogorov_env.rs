@@ -80,6 +80,12 @@ fn gradient_check(objective: Objective) {
         env.step(a).unwrap();
     }
     let g = env.reward_action_gradients(3).unwrap();
+    // A second episode refills the first one's stored states: the same gradients, bitwise.
+    env.reset(2).unwrap();
+    for a in &actions {
+        env.step(a).unwrap();
+    }
+    assert_eq!(env.reward_action_gradients(3).unwrap(), g, "a second episode's gradients");
     let h = 1e-5;
     let mut worst: f64 = 0.0;
     for j in 0..3 {

@@ -161,6 +161,7 @@ fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
 
 #[test]
 fn baselines_evaluate_against_the_uncontrolled_flow() {
+    let tmp = tempfile::tempdir().unwrap();
     let o = hgym(&[
         "eval",
         "--policy",
@@ -170,6 +171,8 @@ fn baselines_evaluate_against_the_uncontrolled_flow() {
         "--episodes",
         "1",
         "--json",
+        "--out",
+        tmp.path().to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", text(&o));
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
@@ -178,6 +181,13 @@ fn baselines_evaluate_against_the_uncontrolled_flow() {
         Some(0.0),
         "zero control is the reference itself"
     );
+    // Beside the numbers, the flow the policy leaves, as images.
+    let dir = tmp.path().join("Cylinder_2D_Re100-zero-coarse");
+    for name in ["metrics.json", "trajectory.mcap", "vorticity.png", "u.png"] {
+        assert!(dir.join(name).is_file(), "{name} missing in {}", dir.display());
+    }
+    let png = std::fs::read(dir.join("vorticity.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"), "vorticity.png is not a PNG");
     assert_eq!(r["actuation_cost"]["mean"].as_f64(), Some(0.0));
     let o = hgym(&[
         "eval",

@@ -111,8 +111,9 @@ pub struct EvalArgs {
     /// TOML file whose [env] table overrides the environment spec.
     #[arg(long)]
     config: Option<PathBuf>,
-    /// Also write the report to <out>/<ID>-<policy>-<level>/metrics.json (+ manifest.json) and
-    /// the episodes to trajectory.mcap.
+    /// Also write the report to <out>/<ID>-<policy>-<level>/metrics.json (+ manifest.json), the
+    /// episodes to trajectory.mcap, and the flow the last episode ends in as images
+    /// (vorticity.png, u.png, v.png).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Flow-field snapshots (u, v, vorticity) in trajectory.mcap at each reset and every K
@@ -592,7 +593,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
             let reference = uncontrolled_c_d(&mut env, &seeds)?;
             pb.set_position(args.episodes);
             let hash = spec.hash();
-            Ok(evaluate(
+            let report = evaluate(
                 &mut env,
                 policy.as_mut(),
                 &name,
@@ -603,17 +604,18 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
                 &reference,
                 trajectory.as_mut(),
                 &mut |k| pb.set_position(args.episodes + k as u64),
-            )?)
+            )?;
+            if let Some(dir) = &out_dir {
+                // The controlled flow as the last episode leaves it, beside the numbers.
+                let last = seeds[seeds.len() - 1];
+                let what = format!("{} under {}, end of the episode from seed {last}", spec.id(), args.policy);
+                hgym::env::rollout::field_pngs(dir, &env.snapshot(), &what)?;
+            }
+            Ok(report)
         })
         .with_context(|| format!("evaluating {} on {}", args.policy, spec.id()))?;
     pb.finish_and_clear();
-    if let Some(out) = &args.out {
-        let slug: String = args
-            .policy
-            .chars()
-            .map(|c| if c.is_ascii_alphanumeric() || c == '.' { c } else { '_' })
-            .collect();
-        let dir = out.join(format!("{}-{}-{}", spec.id(), slug, args.level.name()));
+    if let Some(dir) = &out_dir {
         let run = EvalRun {
             spec: &spec,
             level: args.level,
@@ -621,7 +623,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
             eval_seed: args.eval_seed,
             episodes: args.episodes,
         };
-        run.write(&dir, &report, threads, started.elapsed().as_secs_f64())?;
+        run.write(dir, &report, threads, started.elapsed().as_secs_f64())?;
         eprintln!("results: {}", dir.display());
     }
     if args.json {

@@ -322,6 +322,7 @@ fn backend(e: impl std::fmt::Display) -> EnvError {
 }
 
 /// One control interval of the stored trajectory.
+#[derive(Default)]
 struct Record {
     start: Vec<C>,
     physical: Vec<f64>,
@@ -334,6 +335,9 @@ pub struct KolmogorovEnv {
     solver: Kolmogorov,
     substeps: usize,
     history: Vec<Record>,
+    /// Records of earlier episodes, whose buffers the next steps fill again (a step allocates no
+    /// state-sized vector once an episode as long has run).
+    spare: Vec<Record>,
     live: bool,
     clock: super::clock::SolverClock,
     theta: f64,
@@ -373,6 +377,7 @@ impl KolmogorovEnv {
             solver,
             substeps,
             history: vec![],
+            spare: vec![],
             live: false,
             clock: Default::default(),
             u: vec![0.0; n * n],
@@ -494,7 +499,7 @@ impl Env for KolmogorovEnv {
         for _ in 0..offset {
             self.solver.step(&zero).map_err(backend)?;
         }
-        self.history.clear();
+        self.spare.append(&mut self.history);
         self.live = true;
         let mut info = Info::default();
         info.set("t", 0.0);
@@ -509,18 +514,21 @@ impl Env for KolmogorovEnv {
             return Err(EnvError::NeedsReset);
         }
         let (a, clipped) = checked_action(&self.action_space(), action)?;
-        let physical: Vec<f64> = a.iter().map(|v| v * self.spec.max_amplitude).collect();
-        self.history.push(Record {
-            start: self.solver.omega.clone(),
-            physical: physical.clone(),
-            normalised: a.clone(),
-        });
+        let mut record = self.spare.pop().unwrap_or_default();
+        record.start.clear();
+        record.start.extend_from_slice(&self.solver.omega);
+        record.physical.clear();
+        record.physical.extend(a.iter().map(|v| v * self.spec.max_amplitude));
+        record.normalised.clear();
+        record.normalised.extend_from_slice(&a);
+        self.history.push(record);
+        let physical = &self.history[self.history.len() - 1].physical;
         let m = self.substeps;
         let (mut eps, mut excess, mut tke, mut flow) = (0.0, 0.0, 0.0, 0.0);
         let mut failure = None;
         for _ in 0..m {
             let t = std::time::Instant::now();
-            let stepped = self.solver.step(&physical);
+            let stepped = self.solver.step(physical);
             self.clock.stop(t);
             if let Err(e) = stepped {
                 failure = Some(e.to_string());

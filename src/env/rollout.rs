@@ -241,7 +241,12 @@ fn write(dir: &Path, summary: &RolloutManifest, m: &Metrics, env: &mut Box<dyn F
         summary.env_id, summary.level, summary.policy, summary.seed
     );
     plots::time_series(&dir.join("rollout.png"), &title, &m.t, &panels, None)?;
-    let snapshot = env.snapshot();
+    field_pngs(dir, &env.snapshot(), &format!("{} at the end", summary.env_id))
+}
+
+/// Each field of `snapshot` (u, v, vorticity, ...) as `<dir>/<name>.png`, titled
+/// `<what>: <name>`.
+pub fn field_pngs(dir: &Path, snapshot: &crate::data::field::Snapshot, what: &str) -> Result<(), ReportError> {
     for (name, values) in &snapshot.fields {
         let field = crate::flow::Field {
             nx: snapshot.nx,
@@ -249,11 +254,7 @@ fn write(dir: &Path, summary: &RolloutManifest, m: &Metrics, env: &mut Box<dyn F
             extent: snapshot.extent,
             values: values.clone(),
         };
-        plots::field_png(
-            &field,
-            &dir.join(format!("{name}.png")),
-            &format!("{}: {name} at the end", summary.env_id),
-        )?;
+        plots::field_png(&field, &dir.join(format!("{name}.png")), &format!("{what}: {name}"))?;
     }
     Ok(())
 }
