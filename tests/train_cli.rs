@@ -65,6 +65,7 @@ fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
         "curve.csv",
         "curve.png",
         "drag_reduction.png",
+        "vorticity.png",
         "checkpoint.bin",
     ] {
         assert!(run.join(f).exists(), "missing {f}");
@@ -82,6 +83,20 @@ fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
     assert_eq!(s["counts"]["/obs"], 201, "reset observation + 200: {s}");
     assert_eq!(s["episodes"], serde_json::json!([0]));
     assert_eq!(s["env_id"], "Cylinder_2D_Re100");
+
+    // The same command again keeps the finished run (no retraining, nothing rewritten); with
+    // another budget it refuses to overwrite the run, naming what differs.
+    let before = read(&run.join("metrics.json"));
+    let o = hgym(&td3_args(&cfg, &full));
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("finished already"), "{}", text(&o));
+    assert_eq!(read(&run.join("metrics.json")), before);
+    let mut other = td3_args(&cfg, &full);
+    other[6] = "2000";
+    let o = hgym(&other);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("config_toml differ"), "{}", text(&o));
+    assert_eq!(read(&run.join("metrics.json")), before);
 
     // Interrupted with SIGINT (Ctrl-C) during the run, then resumed.
     let cut = tmp.path().join("cut");

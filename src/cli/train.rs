@@ -39,7 +39,9 @@ pub struct TrainArgs {
     /// Seed of the learner and of every episode's initial phase.
     #[arg(long, default_value_t = 0, conflicts_with = "seeds")]
     seed: u64,
-    /// Several seeds, one run each, then a summary: `0..3` (0, 1, 2), `0..=4`, or `1,5,9`.
+    /// Several seeds, one run each, then a summary: `0..3` (0, 1, 2), `0..=4`, or `1,5,9`. A seed
+    /// whose folder already holds a finished run of the same set-up is kept, not trained again, so
+    /// seeds trained by separate commands (e.g. two at once) join one summary.
     #[arg(long)]
     seeds: Option<String>,
     /// Environment transitions to collect (default: the config's `train.steps`, 20000).
@@ -369,6 +371,18 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
     let mut finished = vec![];
     for (opts, ck) in jobs {
         refuse_parallel_envs_on_ranks(&opts, threads)?;
+        if ck.is_none() {
+            if let Some(report) = finished_run(&opts)? {
+                eprintln!(
+                    "{} seed {}: finished already in {} (same spec and configuration), kept; delete the folder to train it again",
+                    opts.env_id,
+                    opts.seed,
+                    opts.out.display()
+                );
+                finished.push((opts.seed, opts.out.clone(), report, opts.clone()));
+                continue;
+            }
+        }
         let label = format!("{} s{}", opts.algo, opts.seed);
         let pb = progress_bar(opts.config.train.steps, &label);
         if let Some(ck) = &ck {
@@ -683,6 +697,50 @@ pub struct CompareArgs {
     /// Worker threads (default: all cores); results are bitwise repeatable for the same seed and thread count.
     #[arg(long)]
     threads: Option<usize>,
+}
+
+/// The final evaluation of a run that `opts` would start afresh but that is finished already in
+/// `opts.out` (a `--seeds` command given again continues with the seeds still to do, and its
+/// summary covers them all); `None` if the folder holds no finished run. A finished run of
+/// another set-up (spec, algorithm, seed, level, configuration, source run) is refused rather
+/// than overwritten.
+fn finished_run(opts: &TrainOptions) -> Result<Option<EvalReport>> {
+    let metrics = opts.out.join("metrics.json");
+    if !metrics.exists() {
+        return Ok(None);
+    }
+    let read = |path: &Path| -> Result<serde_json::Value> {
+        let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))
+    };
+    let manifest = read(&opts.out.join("manifest.json"))?;
+    let spec = resolve_spec(&opts.env_id, &opts.config).map_err(train_error)?;
+    let expected = [
+        ("spec_hash", serde_json::json!(spec.hash())),
+        ("algo", serde_json::json!(opts.algo)),
+        ("seed", serde_json::json!(opts.seed)),
+        ("level", serde_json::json!(opts.level.name())),
+        ("config_toml", serde_json::json!(opts.config.to_toml())),
+    ];
+    let mut differ: Vec<&str> = expected
+        .iter()
+        .filter(|(key, value)| manifest.get(*key) != Some(value))
+        .map(|(key, _)| *key)
+        .collect();
+    if manifest.get("init_from").is_some() != opts.init.is_some() {
+        differ.push("init_from");
+    }
+    if !differ.is_empty() {
+        return Err(UsageError(format!(
+            "{} holds a finished run of another set-up ({} differ): give another --out, or delete the folder to train it again",
+            opts.out.display(),
+            differ.join(", ")
+        ))
+        .into());
+    }
+    let report: EvalReport = serde_json::from_value(read(&metrics)?)
+        .with_context(|| format!("{} is not a training run's final evaluation", metrics.display()))?;
+    Ok(Some(report))
 }
 
 /// One run of a protocol (`hgym compare`, `hgym transfer`) in `opts.out`, with a progress bar:

@@ -9,7 +9,8 @@
 //! - `policy.json`: the final deterministic policy (`hgym eval --policy DIR` loads it);
 //!   for a flow that declares agents (`hgym_agents::multi`: the channel flows), one actor shared
 //!   by every agent, trained through one pseudo-environment per agent (`[train] multi_agent`);
-//! - `metrics.json`: the final evaluation ([`eval::EvalReport`]);
+//! - `metrics.json`: the final evaluation ([`eval::EvalReport`]); one image per snapshot field
+//!   of the flow its last episode ends in (the 2D flows: `vorticity.png`, `u.png`, `v.png`);
 //! - `init_from.json`: for a run started from another run's policy (`--init-from`), where it
 //!   started and how the source was mapped (also in the manifest); such a run evaluates its
 //!   starting policy before the first round (curve row 0), which is the source policy's
@@ -377,6 +378,15 @@ pub fn train(
         &mut |_| {},
     )?;
     trajectory.finish()?;
+    // The flow the learned policy leaves at the end of the last evaluation episode, as images.
+    let what = format!(
+        "{} under {} seed {}, end of the episode from seed {}",
+        spec.id(),
+        algo.name(),
+        opts.seed,
+        final_seeds[final_seeds.len() - 1]
+    );
+    crate::env::rollout::field_pngs(&opts.out, &eval_env.snapshot(), &what)?;
     write_json(&opts.out.join("policy.json"), "the policy", &policy)?;
     write_json(&opts.out.join("metrics.json"), "the evaluation", &report)?;
     let csv = opts.out.join("curve.csv");
