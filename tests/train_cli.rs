@@ -379,6 +379,8 @@ fn hostile_policies_and_baselines_exit_2_naming_the_problem() {
         ("constant=inf", "not a finite number"),
         ("constant=1e308", "outside the normalised action range"),
         ("constant=nan", "not a finite number"),
+        ("constant=0,2", "2 is outside the normalised action range"),
+        ("constant=0.5,-0.5", "2 constant values for 1 actuators"),
         ("sine=nan", "not a finite number"),
         ("sine=0", "must be positive"),
         ("pd=obs:999,1,0", "obs:999 does not exist"),

@@ -25,8 +25,9 @@ pub enum Signal {
 pub enum Baseline {
     /// No actuation.
     Zero,
-    /// The same action every step.
-    Constant { value: f64 },
+    /// The same action every step: one value for every actuator, or one per actuator (e.g. the
+    /// pinball's boat-tailing `[0, -1, 1]`: front still, rear cylinders counter-rotating).
+    Constant { values: Vec<f64> },
     /// Uniform in [-1, 1].
     Random,
     /// `amplitude sin(2 pi k / period + phase)` at action k, on every actuator.
@@ -67,8 +68,12 @@ impl BaselinePolicy {
 }
 
 impl Policy for BaselinePolicy {
-    fn check(&self, obs: &[f64], info: &Info) -> Result<(), String> {
+    fn check(&self, obs: &[f64], info: &Info, act_dim: usize) -> Result<(), String> {
         match &self.baseline {
+            Baseline::Constant { values } if values.len() != 1 && values.len() != act_dim => Err(format!(
+                "{} constant values for {act_dim} actuators: give one value for all, or one per actuator",
+                values.len()
+            )),
             Baseline::Pd {
                 signal: Signal::Obs(i), ..
             } if *i >= obs.len() => Err(format!(
@@ -103,7 +108,11 @@ impl Policy for BaselinePolicy {
         self.k += 1;
         match &self.baseline {
             Baseline::Zero => action.iter_mut().for_each(|a| *a = 0.0),
-            Baseline::Constant { value } => action.iter_mut().for_each(|a| *a = value.clamp(-1.0, 1.0)),
+            Baseline::Constant { values } => {
+                for (j, a) in action.iter_mut().enumerate() {
+                    *a = values[if values.len() == 1 { 0 } else { j }].clamp(-1.0, 1.0);
+                }
+            }
             Baseline::Random => action.iter_mut().for_each(|a| *a = 2.0 * self.rng.uniform() - 1.0),
             Baseline::Sine { amplitude, period } => {
                 let v = amplitude * (2.0 * std::f64::consts::PI * k / period.max(1e-9)).sin();
@@ -135,5 +144,32 @@ impl Policy for BaselinePolicy {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One constant value drives every actuator; a list gives each its own, clipped to [-1, 1];
+    /// a list of the wrong length is refused before the first action.
+    #[test]
+    fn constant_values_per_actuator() {
+        let info = Info::default();
+        let mut a = [9.0; 3];
+        BaselinePolicy::new(Baseline::Constant { values: vec![0.25] }, 0).act(&[], &info, &mut a);
+        assert_eq!(a, [0.25; 3]);
+        let boat_tailing = BaselinePolicy::new(
+            Baseline::Constant {
+                values: vec![0.0, -1.0, 1.0],
+            },
+            0,
+        );
+        let mut p = boat_tailing.clone();
+        p.act(&[], &info, &mut a);
+        assert_eq!(a, [0.0, -1.0, 1.0]);
+        assert!(boat_tailing.check(&[], &info, 3).is_ok());
+        let e = boat_tailing.check(&[], &info, 2).unwrap_err();
+        assert!(e.contains("3 constant values for 2 actuators"), "{e}");
     }
 }

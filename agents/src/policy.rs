@@ -11,8 +11,9 @@ use crate::normalize::RunningMeanStd;
 
 pub trait Policy {
     /// Whether the policy can act on an environment whose step gave `obs` and `info` (the
-    /// observation indices and info keys it reads exist); the message names what is missing.
-    fn check(&self, _obs: &[f64], _info: &Info) -> Result<(), String> {
+    /// observation indices and info keys it reads exist, and it has an action for each of the
+    /// `act_dim` actuators); the message names what is missing.
+    fn check(&self, _obs: &[f64], _info: &Info, _act_dim: usize) -> Result<(), String> {
         Ok(())
     }
     /// Called at every reset (feedback controllers clear their memory here).

@@ -89,8 +89,9 @@ pub struct TrainArgs {
 #[derive(Args)]
 pub struct EvalArgs {
     /// A training result folder (its policy.json), or a baseline: zero, random, sine[=period],
-    /// constant=v, opposition[=gain] (a = -gain C_L), wall-opposition[=gain] (channel flows: each
-    /// actuator a = -gain v' at its sensing point), pd=SIGNAL,kp,kd (SIGNAL: obs:i or an info key).
+    /// constant=v[,v2,..] (one value for all actuators, or one each), opposition[=gain]
+    /// (a = -gain C_L), wall-opposition[=gain] (channel flows: each actuator a = -gain v' at its
+    /// sensing point), pd=SIGNAL,kp,kd (SIGNAL: obs:i or an info key).
     #[arg(long)]
     policy: String,
     /// Environment ID. A run folder trained on another flow is mapped onto it (zero-shot
@@ -602,7 +603,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
             env.reset(seeds[0])?;
             let first = env.step(&vec![0.0; spec.act_dim()])?;
             policy
-                .check(&first.obs, &first.info)
+                .check(&first.obs, &first.info, spec.act_dim())
                 .map_err(|m| UsageError(format!("--policy {} on {}: {m}", args.policy, spec.id())))?;
             let reference = uncontrolled_c_d(&mut env, &seeds)?;
             pb.set_position(args.episodes);

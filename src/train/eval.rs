@@ -104,7 +104,8 @@ pub fn evaluate<E: Env + crate::env::fields::FlowFields + ?Sized>(
 }
 
 /// A policy named on the command line: a trained-run folder (its `policy.json`), or a
-/// classical baseline: `zero`, `random`, `sine[=period]`, `constant=v`, `opposition[=gain]`
+/// classical baseline: `zero`, `random`, `sine[=period]`, `constant=v[,v2,..]` (one
+/// value for all actuators or one each), `opposition[=gain]`
 /// (proportional feedback against the lift, `a = -gain C_L`), `wall-opposition[=gain]` (each
 /// wall actuator against the wall-normal velocity at its sensing point, the channel flows'
 /// opposition control), `pd=SIGNAL,kp,kd` with SIGNAL `obs:i` or an info key such as `C_L`.
@@ -144,14 +145,15 @@ pub fn parse_policy(text: &str) -> Result<NamedPolicy, PolicyError> {
                 )))
             }
         },
-        ("constant", Some(v)) => match num(v)? {
-            value if (-1.0..=1.0).contains(&value) => Baseline::Constant { value },
-            value => {
+        ("constant", Some(v)) => {
+            let values = v.split(',').map(num).collect::<Result<Vec<f64>, _>>()?;
+            if let Some(value) = values.iter().find(|x| !(-1.0..=1.0).contains(*x)) {
                 return Err(PolicyError::Invalid(format!(
                     "--policy {text}: {value} is outside the normalised action range [-1, 1]"
-                )))
+                )));
             }
-        },
+            Baseline::Constant { values }
+        }
         ("opposition", g) => Baseline::Pd {
             signal: Signal::Info("C_L".into()),
             kp: g.map(num).transpose()?.unwrap_or(1.0),
@@ -192,7 +194,7 @@ pub fn parse_policy(text: &str) -> Result<NamedPolicy, PolicyError> {
             if !file.exists() {
                 return Err(PolicyError::Invalid(format!(
                     "--policy {text}: neither a result folder with policy.json nor a baseline \
-                     (zero, random, sine[=period], constant=v, opposition[=gain], wall-opposition[=gain], pd=SIGNAL,kp,kd)"
+                     (zero, random, sine[=period], constant=v[,v2,..], opposition[=gain], wall-opposition[=gain], pd=SIGNAL,kp,kd)"
                 )));
             }
             let body = std::fs::read_to_string(&file).map_err(|source| PolicyError::Read {
