@@ -147,6 +147,15 @@ fn zero_shot_fine_tuning_and_a_protocol_from_the_cylinder_to_the_square() {
     // A second call finds every arm done and only recomputes the comparison.
     let o = hgym(&args[..args.len() - 1]);
     assert!(o.status.success() && text(&o).matches("done already").count() == 3, "{}", text(&o));
+    // The same protocol with another budget does not keep the runs of the old one: refused,
+    // naming what differs, with the finished runs left as they were.
+    let before = std::fs::read(root.join("finetune/seed0/metrics.json")).unwrap();
+    let changed = std::fs::read_to_string(&pfile).unwrap().replace("steps = 200", "steps = 400");
+    std::fs::write(&pfile, changed).unwrap();
+    let o = hgym(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("config_toml differ"), "{}", text(&o));
+    assert_eq!(std::fs::read(root.join("finetune/seed0/metrics.json")).unwrap(), before);
 }
 
 #[test]

@@ -701,11 +701,11 @@ pub struct CompareArgs {
 }
 
 /// The final evaluation of a run that `opts` would start afresh but that is finished already in
-/// `opts.out` (a `--seeds` command given again continues with the seeds still to do, and its
-/// summary covers them all); `None` if the folder holds no finished run. A finished run of
+/// `opts.out` (a `--seeds` command or a protocol given again continues with the runs still to
+/// do, and its summary covers them all); `None` if the folder holds no finished run. A finished run of
 /// another set-up (spec, algorithm, seed, level, configuration, source run) is refused rather
 /// than overwritten.
-fn finished_run(opts: &TrainOptions) -> Result<Option<EvalReport>> {
+pub fn finished_run(opts: &TrainOptions) -> Result<Option<EvalReport>> {
     let metrics = opts.out.join("metrics.json");
     if !metrics.exists() {
         return Ok(None);
@@ -802,10 +802,6 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
         for algo in &p.algos {
             for seed in &p.seeds {
                 let dir = root.join(algo).join(format!("seed{seed}"));
-                if dir.join("metrics.json").exists() {
-                    eprintln!("{algo} s{seed}: done already ({})", dir.display());
-                    continue;
-                }
                 let opts = TrainOptions {
                     env_id: p.env.clone(),
                     algo: algo.clone(),
@@ -816,6 +812,10 @@ pub fn run_compare(args: CompareArgs) -> Result<Outcome> {
                     cache: hgym::env::default_cache_dir(),
                     init: None,
                 };
+                if finished_run(&opts)?.is_some() {
+                    eprintln!("{algo} s{seed}: done already ({})", dir.display());
+                    continue;
+                }
                 protocol_run(&pool, opts, &format!("{algo} s{seed}"))?;
                 eprintln!("{algo} s{seed}: finished ({})", dir.display());
             }

@@ -10,7 +10,7 @@ use hgym::train::{resolve_spec, TrainOptions};
 use hgym::transfer::protocol::{Protocol, ARMS};
 use hgym::transfer::SourceRun;
 
-use crate::cli::train::{init_from, install_interrupt, protocol_run, EvalRun};
+use crate::cli::train::{finished_run, init_from, install_interrupt, protocol_run, EvalRun};
 use crate::{thread_pool, Outcome, UsageError};
 
 #[derive(Args)]
@@ -108,11 +108,11 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
                 k += 1;
                 let dir = p.arm_dir(&root, arm, seed);
                 let label = format!("{arm} s{seed} ({k}/{total})");
-                if dir.join("metrics.json").exists() {
-                    eprintln!("{label}: done already ({})", dir.display());
-                    continue;
-                }
                 if arm == "zeroshot" {
+                    if dir.join("metrics.json").exists() {
+                        eprintln!("{label}: done already ({})", dir.display());
+                        continue;
+                    }
                     pool.install(|| zeroshot(&p, src, &target, &dir, threads))?;
                     eprintln!("{label}: evaluated ({})", dir.display());
                     continue;
@@ -131,6 +131,10 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
                     cache: hgym::env::default_cache_dir(),
                     init,
                 };
+                if finished_run(&opts)?.is_some() {
+                    eprintln!("{label}: done already ({})", dir.display());
+                    continue;
+                }
                 protocol_run(&pool, opts, &label)?;
                 eprintln!("{label}: finished ({})", dir.display());
             }
