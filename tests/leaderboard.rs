@@ -71,6 +71,27 @@ fn leaderboard_rebuilds_the_committed_one_from_the_committed_results() {
     assert!(stale("2560ad80") && !stale("777475c1") && !stale("a42c4a1a"));
     let heading = md.find("# Stale").expect("a stale section");
     assert!(md.find("spec 2560ad80").unwrap() > heading && md.find("spec 777475c1").unwrap() < heading);
+    // Each current entry of a flow with references says how far its uncontrolled flow is from
+    // the literature at its level: the committed row of `hgym validate --env`, in the JSON and
+    // under the section's heading; a stale entry says nothing of a flow that no longer exists.
+    let table: toml::Table = std::fs::read_to_string(root.join("benchmarks/envs/fidelity.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    let st = table["Cylinder_2D_Re100@coarse"]["strouhal"].as_float().unwrap();
+    let cylinder = entries
+        .iter()
+        .find(|e| e["spec_hash"].as_str().unwrap().starts_with("a42c4a1a") && e["policy"] == "td3")
+        .unwrap();
+    let text = cylinder["literature"]
+        .as_str()
+        .expect("a literature line for Cylinder_2D_Re100 at coarse");
+    assert!(
+        text.starts_with(&format!("St {st:.4} (")) && text.contains("cylinder_re100"),
+        "{text}"
+    );
+    assert!(md.contains(&format!("The uncontrolled flow at this level: {text}.")));
+    assert!(entries.iter().filter(|e| e["stale"] == true).all(|e| e.get("literature").is_none()));
     // Every entry says how to make it again; a training run's command takes the run's own
     // configuration from its folder (`--config RUN_DIR`), and each entry links its folders.
     let td3 = "hgym train --env Cylinder_2D_Re100 --algo td3 --res coarse --seeds 0..=2 \

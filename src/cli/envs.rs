@@ -6,7 +6,6 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use hgym::env::family::CalibrateError;
-use hgym::env::Spec;
 
 use super::progress::Progress;
 use crate::{thread_pool, Outcome, UsageError};
@@ -44,22 +43,6 @@ pub enum EnvsCommand {
     },
 }
 
-/// The committed deviations of `s`'s uncontrolled flow at `level` from the literature
-/// (`hgym validate --env ID --level L --record`), if measured on the flow registered now.
-fn fidelity_entry(s: &Spec, level: Level) -> Option<&'static hgym::fidelity::Entry> {
-    hgym::fidelity::committed(hgym::env::registry::lbm_flow(s)?, level)
-}
-
-/// `St -2.7% C_D +13.7%`; `-` without references (the Kolmogorov flows' check is `hgym validate
-/// kolmogorov`); `not measured`.
-fn fidelity(s: &Spec, level: Level) -> String {
-    match (hgym::env::registry::lbm_flow(s), fidelity_entry(s, level)) {
-        (_, Some(e)) => e.summary(),
-        (Some(spec), None) if hgym::fidelity::has_reference(spec) => "not measured".into(),
-        _ => "-".into(),
-    }
-}
-
 pub fn run(args: EnvsArgs) -> Result<Outcome> {
     match args.command {
         None => {
@@ -74,8 +57,8 @@ pub fn run(args: EnvsArgs) -> Result<Outcome> {
                             "differentiable": s.differentiable(),
                             "calibrated": s.calibrated(), "spec_hash": s.hash(),
                             "fidelity": {
-                                "coarse": fidelity_entry(s, Level::Coarse),
-                                "default": fidelity_entry(s, Level::Default),
+                                "coarse": hgym::fidelity::known(s, Level::Coarse).entry(),
+                                "default": hgym::fidelity::known(s, Level::Default).entry(),
                             },
                         })
                     })
@@ -96,8 +79,8 @@ pub fn run(args: EnvsArgs) -> Result<Outcome> {
                         s.act_dim(),
                         s.solver(),
                         if s.calibrated() { "yes" } else { "no" },
-                        fidelity(s, Level::Coarse),
-                        fidelity(s, Level::Default)
+                        hgym::fidelity::known(s, Level::Coarse).summary(),
+                        hgym::fidelity::known(s, Level::Default).summary()
                     );
                 }
             }

@@ -38,21 +38,41 @@ pub struct LeaderboardArgs {
     json: bool,
 }
 
-/// The spec hash today's registry gives `id` with a run's training configuration (its `[env]`
-/// overrides); without one, the registered spec's.
-fn current_hash(id: &str, config_toml: Option<&str>) -> Option<String> {
+/// The spec today's registry gives `id` with a run's training configuration (its `[env]`
+/// overrides); without one, the registered spec.
+fn run_spec(id: &str, config_toml: Option<&str>) -> Option<hgym::env::Spec> {
     match config_toml {
         Some(text) => {
             let config = hgym::train::config::TrainConfig::parse(text, "a run's manifest").ok()?;
-            hgym::train::resolve_spec(id, &config).ok().map(|s| s.hash())
+            hgym::train::resolve_spec(id, &config).ok()
         }
-        None => hgym::env::lookup(id).ok().map(|s| s.hash()),
+        None => hgym::env::lookup(id).ok(),
+    }
+}
+
+fn current_hash(id: &str, config_toml: Option<&str>) -> Option<String> {
+    run_spec(id, config_toml).map(|s| s.hash())
+}
+
+/// The committed deviation from the literature of the uncontrolled flow of `id` at `level` with
+/// a run's training configuration (`hgym validate --env ID --level L --record`).
+fn literature(id: &str, level: &str, config_toml: Option<&str>) -> Option<String> {
+    use hgym::fidelity::Known;
+    let spec = run_spec(id, config_toml)?;
+    let level: hgym::flow::Level = level.parse().ok()?;
+    match hgym::fidelity::known(&spec, level) {
+        Known::Measured(e) => Some(e.describe()),
+        Known::NotMeasured => Some(format!(
+            "not measured against the literature (`hgym validate --env {id} --level {}` measures it)",
+            level.name()
+        )),
+        Known::NoReference => None,
     }
 }
 
 /// `hgym leaderboard`: writes results/leaderboard.json, LEADERBOARD.md and the bar charts.
 pub fn leaderboard(args: LeaderboardArgs) -> Result<Outcome> {
-    let lb = hgym::report::leaderboard::build(&args.results, args.env.as_deref(), &current_hash);
+    let lb = hgym::report::leaderboard::build(&args.results, args.env.as_deref(), &current_hash, &literature);
     hgym::report::leaderboard::write(&args.results, &lb)?;
     if !lb.problems.is_empty() {
         eprintln!(

@@ -86,6 +86,30 @@ impl Entry {
         }
     }
 
+    /// `St 0.1605 (-2.7 %), mean C_D 1.5116 (+13.7 %) against the references of cylinder_re100:
+    /// outside its tolerances`, a sentence for reports.
+    pub fn describe(&self) -> String {
+        if self.status == Status::Diverged {
+            return format!("diverged (case {})", self.case);
+        }
+        let part = |name: &str, value: Option<f64>, deviation: Option<f64>| match (value, deviation) {
+            (Some(v), Some(d)) => format!("{name} {v:.4} ({:+.1} %)", 100.0 * d),
+            (Some(v), None) => format!("{name} {v:.4}"),
+            _ => format!("{name} n/a"),
+        };
+        let verdict = match self.status {
+            Status::Pass => "within its tolerances",
+            Status::Fail => "outside its tolerances",
+            _ => "measured, not judged",
+        };
+        format!(
+            "{}, {} against the references of {}: {verdict}",
+            part("St", self.strouhal, self.strouhal_deviation),
+            part("mean C_D", self.mean_cd, self.mean_cd_deviation),
+            self.case,
+        )
+    }
+
     /// `St +2.1% C_D +14.3%` (or `diverged`).
     pub fn summary(&self) -> String {
         if self.status == Status::Diverged {
@@ -94,6 +118,48 @@ impl Entry {
         // n/a: the run gave no value (e.g. no whole shedding period for St).
         let pct = |d: Option<f64>| d.map_or("n/a".to_string(), |d| format!("{:+.1}%", 100.0 * d));
         format!("St {} C_D {}", pct(self.strouhal_deviation), pct(self.mean_cd_deviation))
+    }
+}
+
+/// What is known of an environment's uncontrolled flow against the literature at a level.
+#[derive(Clone, Copy, Debug)]
+pub enum Known {
+    /// The committed row, measured on the flow registered now.
+    Measured(&'static Entry),
+    /// The flow has references but no current row at this level.
+    NotMeasured,
+    /// No references here: not a lattice-Boltzmann flow (the Kolmogorov flows' check is `hgym
+    /// validate kolmogorov`), or no validation case for its family and Reynolds number.
+    NoReference,
+}
+
+impl Known {
+    /// `St -2.7% C_D +13.7%`, `not measured` or `-` (the `hgym envs` column).
+    pub fn summary(&self) -> String {
+        match self {
+            Known::Measured(e) => e.summary(),
+            Known::NotMeasured => "not measured".into(),
+            Known::NoReference => "-".into(),
+        }
+    }
+
+    pub fn entry(&self) -> Option<&'static Entry> {
+        match self {
+            Known::Measured(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+/// What the committed table says of environment `spec`'s uncontrolled flow at `level`.
+pub fn known(spec: &crate::env::Spec, level: Level) -> Known {
+    match crate::env::registry::lbm_flow(spec) {
+        Some(flow) => match committed(flow, level) {
+            Some(e) => Known::Measured(e),
+            None if has_reference(flow) => Known::NotMeasured,
+            None => Known::NoReference,
+        },
+        None => Known::NoReference,
     }
 }
 

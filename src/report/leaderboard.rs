@@ -42,6 +42,10 @@ pub struct Entry {
     /// The spec hash is not the current one for these runs (see the module's doc).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub stale: bool,
+    /// How far the uncontrolled flow of this environment and level is from the literature
+    /// (`hgym validate --env ID --level L`), so a reader sees the physics behind the numbers.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub literature: Option<String>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -83,6 +87,10 @@ struct Run {
 /// The spec hash today's registry gives an environment ID with a run's training configuration
 /// (`None`: the ID or the configuration is unknown today).
 pub type CurrentHash<'a> = &'a dyn Fn(&str, Option<&str>) -> Option<String>;
+
+/// What is known of the uncontrolled flow of an environment ID at a level (name) with a run's
+/// training configuration against the literature (`None`: nothing to say).
+pub type Literature<'a> = &'a dyn Fn(&str, &str, Option<&str>) -> Option<String>;
 
 fn read_json(p: &Path) -> Result<serde_json::Value, String> {
     let text = std::fs::read_to_string(p).map_err(|e| format!("cannot read {}: {e}", p.display()))?;
@@ -165,8 +173,9 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Probl
 }
 
 /// Builds the leaderboard from everything under `results` (optionally one environment);
-/// `current` tells which spec hashes are today's.
-pub fn build(results: &Path, env: Option<&str>, current: CurrentHash) -> Leaderboard {
+/// `current` tells which spec hashes are today's, `literature` how far each current entry's
+/// uncontrolled flow is from the literature.
+pub fn build(results: &Path, env: Option<&str>, current: CurrentHash, literature: Literature) -> Leaderboard {
     let (mut runs, mut problems) = (vec![], vec![]);
     collect(results, results.parent().unwrap_or(Path::new(".")), &mut runs, &mut problems);
     let mut groups: BTreeMap<(String, String, String, String), Vec<Run>> = BTreeMap::new();
@@ -188,6 +197,9 @@ pub fn build(results: &Path, env: Option<&str>, current: CurrentHash) -> Leaderb
                 .any(|r| current(&env_id, r.config_toml.as_deref()).as_deref() != Some(spec_hash.as_str()));
             Entry {
                 reproduce: reproduce(&env_id, &level, &policy, &runs),
+                literature: (!stale)
+                    .then(|| literature(&env_id, &level, runs[0].config_toml.as_deref()))
+                    .flatten(),
                 stale,
                 kind: runs[0].kind.to_string(),
                 seeds: runs.len(),
@@ -290,9 +302,13 @@ pub fn markdown(lb: &Leaderboard) -> String {
             rank = 0;
             let short = &e.spec_hash[..e.spec_hash.len().min(8)];
             s += &format!(
-                "\n## {} ({}, spec {short})\n\n![{}](leaderboard/{}-{}-{short}.png)\n\n| rank | policy | kind | seeds | drag reduction | return | samples | wall time | code |\n|---|---|---|---|---|---|---|---|---|\n",
+                "\n## {} ({}, spec {short})\n\n![{}](leaderboard/{}-{}-{short}.png)\n\n",
                 e.env_id, e.level, e.env_id, e.env_id, e.level
             );
+            if let Some(text) = &e.literature {
+                s += &format!("The uncontrolled flow at this level: {text}.\n\n");
+            }
+            s += "| rank | policy | kind | seeds | drag reduction | return | samples | wall time | code |\n|---|---|---|---|---|---|---|---|---|\n";
         }
         rank += 1;
         s += &format!(
