@@ -101,6 +101,31 @@ fn leaderboard_rebuilds_the_committed_one_from_the_committed_results() {
         .all(|e| e["reproduce"].as_str().is_some_and(|c| c.starts_with("hgym "))));
     assert!(entries.iter().any(|e| e["reproduce"] == td3), "no entry reproduced by {td3}");
     assert!(md.contains(&format!("`{td3}`")) && md.contains("[seed2](train/Cylinder_2D_Re100-td3-coarse/seed2)"));
+    // A transfer protocol's three arms are three entries, not one: from scratch, fine-tuned
+    // (named by its source flow) and zero-shot (its five evaluations one entry, not five
+    // baselines named by a path), each reproduced by the protocol.
+    let arms: Vec<(&str, &str, u64)> = entries
+        .iter()
+        .filter(|e| e["env_id"] == "Cylinder_2D_Re1000")
+        .map(|e| {
+            (
+                e["policy"].as_str().unwrap(),
+                e["kind"].as_str().unwrap(),
+                e["seeds"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    for arm in [
+        ("td3", "learned", 5),
+        ("td3 fine-tuned from Cylinder_2D_Re200", "learned", 5),
+        ("td3 zero-shot from Cylinder_2D_Re200", "zero-shot", 5),
+    ] {
+        assert!(arms.contains(&arm), "{arm:?} not among {arms:?}");
+    }
+    assert!(entries
+        .iter()
+        .filter(|e| e["env_id"] == "Cylinder_2D_Re1000" && e["kind"] != "baseline")
+        .all(|e| e["reproduce"] == "hgym transfer --protocol benchmarks/protocols/transfer/cylinder_re200_re1000.toml"));
     let o = Command::new(env!("CARGO_BIN_EXE_hgym"))
         .current_dir(root)
         .args([

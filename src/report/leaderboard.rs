@@ -2,10 +2,11 @@
 //! `results/LEADERBOARD.md` and one bar chart per environment (`results/leaderboard/<ID>.png`).
 //!
 //! Sources: training runs (`results/train/<ID>-<algo>-<level>/seed<S>/` and the runs of
-//! comparison protocols under `results/compare/`), each with `metrics.json` (final deterministic
-//! evaluation) and `manifest.json`; classical baselines evaluated with `hgym eval --out
-//! results/eval` (`results/eval/<ID>-<policy>-<level>/`). Entries are grouped by (environment,
-//! level, algorithm or baseline); per entry: seeds, mean +- std over seeds of the drag reduction
+//! comparison and transfer protocols under `results/compare/` and `results/transfer/`), each with
+//! `metrics.json` (final deterministic evaluation) and `manifest.json`; classical baselines
+//! evaluated with `hgym eval --out results/eval` (`results/eval/<ID>-<policy>-<level>/`), and
+//! policies of another flow evaluated zero-shot. Entries are grouped by (environment, level,
+//! algorithm or baseline; a fine-tuned or zero-shot policy by its source flow too); per entry: seeds, mean +- std over seeds of the drag reduction
 //! (for flows with a drag coefficient) and of the return, samples, wall time, code versions.
 //! Ranking: by drag reduction where there is one, else by return.
 //!
@@ -115,6 +116,14 @@ fn read_eval(p: &Path) -> Result<Option<(EvalReport, serde_json::Value)>, String
     Ok(Some((report, manifest)))
 }
 
+/// `td3 zero-shot from Cylinder_2D_Re200` when an evaluation's `--policy` is a training run
+/// folder (relative to `root`) of another environment than `env_id`.
+fn zero_shot_source(root: &Path, policy: &str, env_id: &str) -> Option<String> {
+    let source = read_json(&root.join(policy).join("manifest.json")).ok()?;
+    let (algo, from) = (source["algo"].as_str()?, source["env_id"].as_str()?);
+    (source["schema"] == "hgym/train/v1" && from != env_id).then(|| format!("{algo} zero-shot from {from}"))
+}
+
 /// Every folder below `dir` holding a `metrics.json` of the evaluation schema; folders whose
 /// `metrics.json` cannot be read go to `problems`.
 fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Problem>) {
@@ -139,7 +148,7 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Probl
             }
         };
         let trained = manifest["schema"] == "hgym/train/v1";
-        let policy = if trained {
+        let (policy, kind) = if trained {
             let Some(algo) = manifest["algo"].as_str() else {
                 problems.push(Problem {
                     dir: shown,
@@ -147,15 +156,22 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Probl
                 });
                 continue;
             };
-            algo.to_string()
+            match manifest["init_from"]["env_id"].as_str() {
+                Some(source) => (format!("{algo} fine-tuned from {source}"), "learned"),
+                None => (algo.to_string(), "learned"),
+            }
         } else {
-            manifest["policy"].as_str().unwrap_or(&report.policy).to_string()
+            let named = manifest["policy"].as_str().unwrap_or(&report.policy);
+            match zero_shot_source(root, named, &report.env_id) {
+                Some(label) => (label, "zero-shot"),
+                None => (named.to_string(), "baseline"),
+            }
         };
         out.push(Run {
             env_id: report.env_id.clone(),
             level: report.level.clone(),
             policy,
-            kind: if trained { "learned" } else { "baseline" },
+            kind,
             samples: manifest["samples"].as_u64(),
             wall: manifest["manifest"]["wall_time_s"].as_f64(),
             version: manifest["manifest"]["git_commit"]
@@ -177,7 +193,8 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Probl
 /// uncontrolled flow is from the literature.
 pub fn build(results: &Path, env: Option<&str>, current: CurrentHash, literature: Literature) -> Leaderboard {
     let (mut runs, mut problems) = (vec![], vec![]);
-    collect(results, results.parent().unwrap_or(Path::new(".")), &mut runs, &mut problems);
+    let root = results.parent().unwrap_or(Path::new("."));
+    collect(results, root, &mut runs, &mut problems);
     let mut groups: BTreeMap<(String, String, String, String), Vec<Run>> = BTreeMap::new();
     for r in runs.into_iter().filter(|r| env.is_none_or(|e| r.env_id == e)) {
         let key = (r.env_id.clone(), r.level.clone(), r.report.spec_hash.clone(), r.policy.clone());
@@ -236,11 +253,29 @@ pub fn build(results: &Path, env: Option<&str>, current: CurrentHash, literature
     }
 }
 
-/// `hgym train` with the first run's configuration (`--config RUN_DIR`) over the entry's seeds,
-/// or `hgym eval` of the baseline with its seeds.
+/// The protocol that made a run of `results/transfer/<name>/` or `results/compare/<name>/` (the
+/// protocols' files are named by their `name`).
+fn protocol_command(dir: &Path) -> Option<String> {
+    let mut parts = dir.components().map(|c| c.as_os_str().to_str());
+    let (Some(Some("results")), Some(Some(command)), Some(Some(name))) = (parts.next(), parts.next(), parts.next()) else {
+        return None;
+    };
+    match command {
+        "transfer" => Some(format!("hgym transfer --protocol benchmarks/protocols/transfer/{name}.toml")),
+        "compare" => Some(format!("hgym compare --protocol benchmarks/protocols/{name}.toml")),
+        _ => None,
+    }
+}
+
+/// The protocol that made the runs (`hgym transfer` / `hgym compare`); else `hgym train` with
+/// the first run's configuration (`--config RUN_DIR`) over the entry's seeds, or `hgym eval` of
+/// the baseline with its seeds.
 fn reproduce(env: &str, level: &str, policy: &str, runs: &[Run]) -> String {
     let first = &runs[0];
-    if first.kind == "baseline" {
+    if let Some(command) = protocol_command(&first.dir) {
+        return command;
+    }
+    if first.kind != "learned" {
         return format!(
             "hgym eval --env {env} --policy {policy} --res {level} --episodes {} --eval-seed {} --out results/eval",
             first.episodes.unwrap_or(first.report.episodes.len() as u64),
