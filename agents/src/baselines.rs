@@ -109,8 +109,14 @@ impl Policy for BaselinePolicy {
         match &self.baseline {
             Baseline::Zero => action.iter_mut().for_each(|a| *a = 0.0),
             Baseline::Constant { values } => {
+                // `check` refuses a list of another length than the action's.
                 for (j, a) in action.iter_mut().enumerate() {
-                    *a = values[if values.len() == 1 { 0 } else { j }].clamp(-1.0, 1.0);
+                    let v = if values.len() == 1 {
+                        values[0]
+                    } else {
+                        values.get(j).copied().unwrap_or(0.0)
+                    };
+                    *a = v.clamp(-1.0, 1.0);
                 }
             }
             Baseline::Random => action.iter_mut().for_each(|a| *a = 2.0 * self.rng.uniform() - 1.0),

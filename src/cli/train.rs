@@ -702,9 +702,9 @@ pub struct CompareArgs {
 
 /// The final evaluation of a run that `opts` would start afresh but that is finished already in
 /// `opts.out` (a `--seeds` command or a protocol given again continues with the runs still to
-/// do, and its summary covers them all); `None` if the folder holds no finished run. A finished run of
-/// another set-up (spec, algorithm, seed, level, configuration, source run) is refused rather
-/// than overwritten.
+/// do, and its summary covers them all); `None` if the folder holds no finished run. A finished
+/// run of another set-up (spec, algorithm, seed, level, configuration, source run) is refused
+/// rather than overwritten.
 pub fn finished_run(opts: &TrainOptions) -> Result<Option<EvalReport>> {
     let metrics = opts.out.join("metrics.json");
     if !metrics.exists() {

@@ -6,9 +6,10 @@
 //! `metrics.json` (final deterministic evaluation) and `manifest.json`; classical baselines
 //! evaluated with `hgym eval --out results/eval` (`results/eval/<ID>-<policy>-<level>/`), and
 //! policies of another flow evaluated zero-shot. Entries are grouped by (environment, level,
-//! algorithm or baseline; a fine-tuned or zero-shot policy by its source flow too); per entry: seeds, mean +- std over seeds of the drag reduction
-//! (for flows with a drag coefficient) and of the return, samples, wall time, code versions.
-//! Ranking: by drag reduction where there is one, else by return.
+//! algorithm or baseline; a fine-tuned or zero-shot policy by its source flow too); per entry:
+//! seeds, mean +- std over seeds of the drag reduction (for flows with a drag coefficient) and
+//! of the return, samples, wall time, code versions. Ranking: by drag reduction where there is
+//! one, else by return.
 //!
 //! An entry whose spec hash is not the one today's registry gives its runs (the registered spec
 //! with the run's `[env]` overrides) is *stale*: the environment it was trained on no longer
@@ -83,6 +84,8 @@ struct Run {
     init_from: Option<String>,
     episodes: Option<u64>,
     dir: PathBuf,
+    /// An evaluation's `--policy` as given (a baseline or a run folder).
+    evaluated: String,
 }
 
 /// The spec hash today's registry gives an environment ID with a run's training configuration
@@ -148,6 +151,7 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Probl
             }
         };
         let trained = manifest["schema"] == "hgym/train/v1";
+        let evaluated = manifest["policy"].as_str().unwrap_or(&report.policy).to_string();
         let (policy, kind) = if trained {
             let Some(algo) = manifest["algo"].as_str() else {
                 problems.push(Problem {
@@ -161,10 +165,9 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Probl
                 None => (algo.to_string(), "learned"),
             }
         } else {
-            let named = manifest["policy"].as_str().unwrap_or(&report.policy);
-            match zero_shot_source(root, named, &report.env_id) {
+            match zero_shot_source(root, &evaluated, &report.env_id) {
                 Some(label) => (label, "zero-shot"),
-                None => (named.to_string(), "baseline"),
+                None => (evaluated.clone(), "baseline"),
             }
         };
         out.push(Run {
@@ -183,6 +186,7 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Probl
             init_from: manifest["init_from"]["dir"].as_str().map(str::to_string),
             episodes: manifest["episodes"].as_u64(),
             dir: shown,
+            evaluated,
             report,
         });
     }
@@ -277,7 +281,8 @@ fn reproduce(env: &str, level: &str, policy: &str, runs: &[Run]) -> String {
     }
     if first.kind != "learned" {
         return format!(
-            "hgym eval --env {env} --policy {policy} --res {level} --episodes {} --eval-seed {} --out results/eval",
+            "hgym eval --env {env} --policy {} --res {level} --episodes {} --eval-seed {} --out results/eval",
+            first.evaluated,
             first.episodes.unwrap_or(first.report.episodes.len() as u64),
             first.seed.unwrap_or(first.report.episodes.first().map_or(0, |e| e.seed)),
         );
