@@ -204,6 +204,30 @@ fn baselines_evaluate_against_the_uncontrolled_flow() {
     let png = std::fs::read(dir.join("vorticity.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"), "vorticity.png is not a PNG");
     assert_eq!(r["actuation_cost"]["mean"].as_f64(), Some(0.0));
+    // The manifest records an [env] override, so the leaderboard can tell its spec from the
+    // registered one (and give the command with it); without one there is nothing to record.
+    let manifest = |d: &Path| -> serde_json::Value { serde_json::from_str(&read(&d.join("manifest.json"))).unwrap() };
+    assert!(manifest(&dir).get("config_toml").is_none());
+    let cfg = tmp.path().join("short.toml");
+    std::fs::write(&cfg, "[env]\nepisode_actions = 20\n").unwrap();
+    let out = tmp.path().join("short");
+    let o = hgym(&[
+        "eval",
+        "--policy",
+        "zero",
+        "--env",
+        "Cylinder_2D_Re100",
+        "--episodes",
+        "1",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let m = manifest(&out.join("Cylinder_2D_Re100-zero-coarse"));
+    assert!(m["config_toml"].as_str().unwrap().contains("episode_actions = 20"), "{m}");
+    assert_eq!(m["spec"]["episode_actions"], 20);
     let o = hgym(&[
         "eval",
         "--policy",

@@ -505,6 +505,8 @@ pub struct EvalRun<'a> {
     pub policy: &'a str,
     pub eval_seed: u64,
     pub episodes: u64,
+    /// The `--config` the flow was overridden with, as TOML (`None`: the registered spec).
+    pub config_toml: Option<String>,
 }
 
 impl EvalRun<'_> {
@@ -512,7 +514,7 @@ impl EvalRun<'_> {
     pub fn write(&self, dir: &Path, report: &EvalReport, threads: usize, wall_s: f64) -> Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
         std::fs::write(dir.join("metrics.json"), serde_json::to_string_pretty(report)? + "\n")?;
-        let manifest = serde_json::json!({
+        let mut manifest = serde_json::json!({
             "schema": "hgym/eval-manifest/v1",
             "env_id": self.spec.id(),
             "spec_hash": self.spec.hash(),
@@ -523,6 +525,9 @@ impl EvalRun<'_> {
             "episodes": self.episodes,
             "manifest": hgym::report::manifest::manifest(threads, wall_s),
         });
+        if let (Some(toml), Some(m)) = (&self.config_toml, manifest.as_object_mut()) {
+            m.insert("config_toml".into(), toml.clone().into());
+        }
         std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&manifest)? + "\n")?;
         Ok(())
     }
@@ -637,6 +642,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
             policy: &args.policy,
             eval_seed: args.eval_seed,
             episodes: args.episodes,
+            config_toml: args.config.is_some().then(|| config.to_toml()),
         };
         run.write(dir, &report, threads, started.elapsed().as_secs_f64())?;
         eprintln!("results: {}", dir.display());

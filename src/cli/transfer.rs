@@ -222,6 +222,7 @@ fn zeroshot(p: &Protocol, src: &SourceRun, target: &hgym::env::Spec, dir: &std::
         policy: &src.dir.display().to_string(),
         eval_seed: p.config.train.eval_seed,
         episodes: n,
+        config_toml: None,
     };
     run.write(dir, &report, threads, started.elapsed().as_secs_f64())
 }

@@ -280,8 +280,14 @@ fn reproduce(env: &str, level: &str, policy: &str, runs: &[Run]) -> String {
         return command;
     }
     if first.kind != "learned" {
+        let config = first
+            .config_toml
+            .as_ref()
+            .map(|_| format!(" --config {}", first.dir.display()))
+            .unwrap_or_default();
+        let out = first.dir.parent().unwrap_or(Path::new("results/eval")).display();
         return format!(
-            "hgym eval --env {env} --policy {} --res {level} --episodes {} --eval-seed {} --out results/eval",
+            "hgym eval --env {env} --policy {} --res {level} --episodes {} --eval-seed {}{config} --out {out}",
             first.evaluated,
             first.episodes.unwrap_or(first.report.episodes.len() as u64),
             first.seed.unwrap_or(first.report.episodes.first().map_or(0, |e| e.seed)),
