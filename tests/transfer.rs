@@ -86,6 +86,13 @@ fn zero_shot_fine_tuning_and_a_protocol_from_the_cylinder_to_the_square() {
     assert_eq!(m["init_from"]["env_id"], "Cylinder_2D_Re100");
     assert_eq!(m["init_from"]["mapping"]["actions"]["jet_front_bottom"], "-jet_pair");
     assert_eq!(m["init_from"]["identity"], false);
+    // On the leaderboard it is named by its source and made again with its algorithm.
+    let o = hgym(&["leaderboard", "--json", "--results", ft.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o));
+    let lb: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let entry = &lb["entries"][0];
+    assert_eq!(entry["policy"], "td3 fine-tuned from Cylinder_2D_Re100", "{lb:#}");
+    assert!(entry["reproduce"].as_str().unwrap().contains(" --algo td3 --res coarse "), "{lb:#}");
     // Critics need the source's checkpoint and a learner with critics; PPO has none to take.
     let o = hgym(&[&fine_tune[..], &["--algo", "ppo", "--steps", "1", "--out", out]].concat());
     assert_eq!(o.status.code(), Some(2), "{}", text(&o));

@@ -84,8 +84,9 @@ struct Run {
     init_from: Option<String>,
     episodes: Option<u64>,
     dir: PathBuf,
-    /// An evaluation's `--policy` as given (a baseline or a run folder).
-    evaluated: String,
+    /// What the command that made the run was given: a training run's `--algo`, an
+    /// evaluation's `--policy` (a baseline or a run folder).
+    made_with: String,
 }
 
 /// The spec hash today's registry gives an environment ID with a run's training configuration
@@ -151,8 +152,7 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Probl
             }
         };
         let trained = manifest["schema"] == "hgym/train/v1";
-        let evaluated = manifest["policy"].as_str().unwrap_or(&report.policy).to_string();
-        let (policy, kind) = if trained {
+        let (made_with, policy, kind) = if trained {
             let Some(algo) = manifest["algo"].as_str() else {
                 problems.push(Problem {
                     dir: shown,
@@ -160,14 +160,16 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Probl
                 });
                 continue;
             };
-            match manifest["init_from"]["env_id"].as_str() {
-                Some(source) => (format!("{algo} fine-tuned from {source}"), "learned"),
-                None => (algo.to_string(), "learned"),
-            }
+            let label = match manifest["init_from"]["env_id"].as_str() {
+                Some(source) => format!("{algo} fine-tuned from {source}"),
+                None => algo.to_string(),
+            };
+            (algo.to_string(), label, "learned")
         } else {
+            let evaluated = manifest["policy"].as_str().unwrap_or(&report.policy).to_string();
             match zero_shot_source(root, &evaluated, &report.env_id) {
-                Some(label) => (label, "zero-shot"),
-                None => (evaluated.clone(), "baseline"),
+                Some(label) => (evaluated, label, "zero-shot"),
+                None => (evaluated.clone(), evaluated, "baseline"),
             }
         };
         out.push(Run {
@@ -186,7 +188,7 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Probl
             init_from: manifest["init_from"]["dir"].as_str().map(str::to_string),
             episodes: manifest["episodes"].as_u64(),
             dir: shown,
-            evaluated,
+            made_with,
             report,
         });
     }
@@ -217,7 +219,7 @@ pub fn build(results: &Path, env: Option<&str>, current: CurrentHash, literature
                 .iter()
                 .any(|r| current(&env_id, r.config_toml.as_deref()).as_deref() != Some(spec_hash.as_str()));
             Entry {
-                reproduce: reproduce(&env_id, &level, &policy, &runs),
+                reproduce: reproduce(&env_id, &level, &runs),
                 literature: (!stale)
                     .then(|| literature(&env_id, &level, runs[0].config_toml.as_deref()))
                     .flatten(),
@@ -274,7 +276,7 @@ fn protocol_command(dir: &Path) -> Option<String> {
 /// The protocol that made the runs (`hgym transfer` / `hgym compare`); else `hgym train` with
 /// the first run's configuration (`--config RUN_DIR`) over the entry's seeds, or `hgym eval` of
 /// the baseline with its seeds.
-fn reproduce(env: &str, level: &str, policy: &str, runs: &[Run]) -> String {
+fn reproduce(env: &str, level: &str, runs: &[Run]) -> String {
     let first = &runs[0];
     if let Some(command) = protocol_command(&first.dir) {
         return command;
@@ -288,7 +290,7 @@ fn reproduce(env: &str, level: &str, policy: &str, runs: &[Run]) -> String {
         let out = first.dir.parent().unwrap_or(Path::new("results/eval")).display();
         return format!(
             "hgym eval --env {env} --policy {} --res {level} --episodes {} --eval-seed {}{config} --out {out}",
-            first.evaluated,
+            first.made_with,
             first.episodes.unwrap_or(first.report.episodes.len() as u64),
             first.seed.unwrap_or(first.report.episodes.first().map_or(0, |e| e.seed)),
         );
@@ -302,7 +304,8 @@ fn reproduce(env: &str, level: &str, policy: &str, runs: &[Run]) -> String {
     };
     let init = first.init_from.as_ref().map(|d| format!(" --init-from {d}")).unwrap_or_default();
     format!(
-        "hgym train --env {env} --algo {policy} --res {level} --seeds {seeds} --config {}{init}",
+        "hgym train --env {env} --algo {} --res {level} --seeds {seeds} --config {}{init}",
+        first.made_with,
         first.dir.display()
     )
 }
