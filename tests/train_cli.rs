@@ -177,18 +177,17 @@ fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
 #[test]
 fn baselines_evaluate_against_the_uncontrolled_flow() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = hgym(&[
-        "eval",
-        "--policy",
-        "zero",
-        "--env",
-        "Cylinder_2D_Re100",
-        "--episodes",
-        "1",
-        "--json",
-        "--out",
-        tmp.path().to_str().unwrap(),
-    ]);
+    // One episode of `policy` on the cylinder, with `extra` arguments.
+    let eval = |policy: &str, extra: &[&str]| {
+        hgym(
+            &[
+                &["eval", "--policy", policy, "--env", "Cylinder_2D_Re100", "--episodes", "1"],
+                extra,
+            ]
+            .concat(),
+        )
+    };
+    let o = eval("zero", &["--json", "--out", tmp.path().to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o));
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(
@@ -211,33 +210,12 @@ fn baselines_evaluate_against_the_uncontrolled_flow() {
     let cfg = tmp.path().join("short.toml");
     std::fs::write(&cfg, "[env]\nepisode_actions = 20\n").unwrap();
     let out = tmp.path().join("short");
-    let o = hgym(&[
-        "eval",
-        "--policy",
-        "zero",
-        "--env",
-        "Cylinder_2D_Re100",
-        "--episodes",
-        "1",
-        "--config",
-        cfg.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = eval("zero", &["--config", cfg.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o));
     let m = manifest(&out.join("Cylinder_2D_Re100-zero-coarse"));
     assert!(m["config_toml"].as_str().unwrap().contains("episode_actions = 20"), "{m}");
     assert_eq!(m["spec"]["episode_actions"], 20);
-    let o = hgym(&[
-        "eval",
-        "--policy",
-        "opposition=2",
-        "--env",
-        "Cylinder_2D_Re100",
-        "--episodes",
-        "1",
-        "--json",
-    ]);
+    let o = eval("opposition=2", &["--json"]);
     assert!(o.status.success(), "{}", text(&o));
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(r["actuation_cost"]["mean"].as_f64().unwrap() > 0.0);
