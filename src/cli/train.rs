@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use hgym::flow::Level;
 use hgym::train::config::TrainConfig;
-use hgym::train::eval::{evaluate, parse_policy, uncontrolled_c_d, EvalReport, NamedPolicy};
+use hgym::train::eval::{evaluate, parse_policy, uncontrolled, EvalReport, LiftDeviationStat, NamedPolicy};
 use hgym::train::{resolve_spec, resume_options, summarize, Ending, Init, TrainError, TrainOptions};
 use hgym::transfer::mapping::MappingSpec;
 use hgym::transfer::{load_mapping, SourceRun, TransferError};
@@ -462,6 +462,9 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
                         report.ret.std,
                         report.episodes.len()
                     );
+                    if let Some(l) = &report.lift_deviation {
+                        println!("{}", lift_line(l));
+                    }
                     println!("  results: {}", opts.out.display());
                 }
                 finished.push((opts.seed, opts.out.clone(), *report, opts.clone()));
@@ -489,6 +492,12 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
                 summary.ret.std,
                 root.join("summary.json").display()
             );
+            if let Some(l) = summary.lift_deviation_reduction_pct {
+                println!(
+                    "  lift deviation |C_L - C_L,ref| reduced by {:+.2} % +- {:.2} (std over seeds)",
+                    l.mean, l.std
+                );
+            }
         }
     } else if args.json {
         if let Some((_, _, r, _)) = finished.first() {
@@ -610,7 +619,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
             policy
                 .check(&first.obs, &first.info, spec.act_dim())
                 .map_err(|m| UsageError(format!("--policy {} on {}: {m}", args.policy, spec.id())))?;
-            let reference = uncontrolled_c_d(&mut env, &seeds)?;
+            let reference = uncontrolled(&mut env, &seeds)?;
             pb.set_position(args.episodes);
             let hash = spec.hash();
             let report = evaluate(
@@ -680,12 +689,23 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
             report.actuation_cost.mean,
             report.actuation_cost.std
         );
+        if let Some(l) = &report.lift_deviation {
+            println!("{}", lift_line(l));
+        }
     }
     Ok(if report.episodes.iter().any(|e| e.terminated) {
         Outcome::CheckFailed
     } else {
         Outcome::Ok
     })
+}
+
+/// The gust flows' load figure as `hgym eval` and `hgym train` print it.
+fn lift_line(l: &LiftDeviationStat) -> String {
+    format!(
+        "  |C_L - C_L,ref| {:10.4} +- {:.4}   (uncontrolled {:.4}; the lift's deviation from the undisturbed mean)\n  lift deviation reduction {:+.2} % +- {:.2}",
+        l.mean_abs_dc_l.mean, l.mean_abs_dc_l.std, l.uncontrolled_abs_dc_l.mean, l.reduction_pct.mean, l.reduction_pct.std
+    )
 }
 
 #[derive(Args)]

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use hgym::train::eval::{evaluate, uncontrolled_c_d};
+use hgym::train::eval::{evaluate, uncontrolled};
 use hgym::train::{resolve_spec, TrainOptions};
 use hgym::transfer::protocol::{Protocol, ARMS};
 use hgym::transfer::SourceRun;
@@ -202,7 +202,7 @@ fn zeroshot(p: &Protocol, src: &SourceRun, target: &hgym::env::Spec, dir: &std::
     let n = p.config.train.final_eval_episodes.max(1) as u64;
     let seeds: Vec<u64> = (0..n).map(|k| p.config.train.eval_seed + k).collect();
     let mut env = target.make(p.level, hgym::env::default_cache_dir())?;
-    let reference = uncontrolled_c_d(&mut env, &seeds)?;
+    let reference = uncontrolled(&mut env, &seeds)?;
     let name = format!("{} ({}, zero-shot)", src.algo, src.dir.display());
     let report = evaluate(
         &mut env,

@@ -9,7 +9,8 @@
 //!   clipped and counted in `info["clipped"]`. Over the interval's `n` solver steps the actuation
 //!   goes from the previous to the new value with the spec's ramp. The reward uses the
 //!   interval-averaged force coefficients, which `info` reports (`C_D`, `C_L`, and per body
-//!   `C_D_b`, `C_L_b`), with `t` and the physical actuation `actuation_k` (units of U or U/D).
+//!   `C_D_b`, `C_L_b`; under the gust reward also `dC_L`, the lift's deviation from the
+//!   undisturbed flow's mean), with `t` and the physical actuation `actuation_k` (units of U or U/D).
 //!   A solver blow-up ends the episode with `terminated = true`, `info["diverged"] = 1` and the
 //!   reason in `info.text["reason"]`.
 //! - A spec with `thermal` also carries a temperature field (D2Q5, stepped after every flow step
@@ -68,6 +69,7 @@ impl LbmEnv {
         if let Some(n) = super::calibrate::level_normalization(&spec, level) {
             spec.normalization = n;
         }
+        spec.reward = spec.reward.at_level(level);
         let setup = spec.flow_setup();
         let flow_error = |e: FlowError| match e {
             FlowError::Invalid { .. } => EnvError::InvalidSpec(format!("{}: {e}", spec.id)),
@@ -473,6 +475,9 @@ impl Env for LbmEnv {
         let (c_d, c_l) = forces.totals();
         info.set("C_D", c_d);
         info.set("C_L", c_l);
+        if let Some(d) = self.spec.reward.lift_deviation(c_l) {
+            info.set("dC_L", d);
+        }
         let probe_temperature = match &self.spec.reward {
             RewardSpec::ProbeTemperature { probe, .. } => {
                 let t = self.spec.probes.get(*probe).and_then(|p| self.temperature_at(*p));
@@ -545,6 +550,7 @@ pub fn reward(spec: &RewardSpec, forces: &IntervalForces, obs: &[f64], probe_tem
             c_l_ref,
             c_d_ref,
             drag_weight,
+            ..
         } => -(c_l - c_l_ref).abs() - drag_weight * (c_d - c_d_ref).abs(),
     }
 }

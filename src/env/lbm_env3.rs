@@ -90,6 +90,7 @@ fn reward(spec: &RewardSpec, forces: &[[f64; 3]], obs: &[f64], probe_temperature
             c_l_ref,
             c_d_ref,
             drag_weight,
+            ..
         } => {
             let (c_d, c_l) = forces.iter().fold((0.0, 0.0), |(d, l), f| (d + f[0], l + f[1]));
             -(c_l - c_l_ref).abs() - drag_weight * (c_d - c_d_ref).abs()
@@ -570,6 +571,9 @@ impl Env for LbmEnv3 {
         info.set("C_D", total[0]);
         info.set("C_L", total[1]);
         info.set("C_S", total[2]);
+        if let Some(d) = self.spec.reward.lift_deviation(total[1]) {
+            info.set("dC_L", d);
+        }
         for s in 0..segments {
             let of_segment: Vec<[f64; 3]> = (0..c.body.len()).map(|b| c.segment[b * segments + s]).collect();
             info.set(&format!("C_D_seg{s}"), of_segment.iter().map(|f| f[0]).sum());

@@ -75,9 +75,47 @@ pub enum RewardSpec {
     ProbeDeviation,
     /// `r = -|C_L - c_l_ref| - w |C_D - c_d_ref|` (the paper's gust mitigation): force deviation
     /// from the time-averaged coefficients of the undisturbed flow, with `w = drag_weight`.
-    GustLoads { c_l_ref: f64, c_d_ref: f64, drag_weight: f64 },
+    /// `coarse` holds the undisturbed flow's `[C_L, C_D]` at the coarse level where its
+    /// under-resolved flow has other mean forces: the references there (see [`Self::at_level`]).
+    GustLoads {
+        c_l_ref: f64,
+        c_d_ref: f64,
+        drag_weight: f64,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        coarse: Option<[f64; 2]>,
+    },
     /// `-weight |T(probe) / T_wall - target|` (the stenotic pipe; `T_target` in info).
     ProbeTemperature { probe: usize, target: f64, weight: f64 },
+}
+
+impl RewardSpec {
+    /// The reward as an environment at `level` computes it: the gust reward takes its
+    /// references from the undisturbed flow at the same level (its `coarse` pair at coarse), so
+    /// that `C_L - C_L,ref` measures the gust and the control, not the grid's offset.
+    pub fn at_level(&self, level: Level) -> RewardSpec {
+        match self {
+            RewardSpec::GustLoads {
+                drag_weight,
+                coarse: Some([c_l, c_d]),
+                ..
+            } if level == Level::Coarse => RewardSpec::GustLoads {
+                c_l_ref: *c_l,
+                c_d_ref: *c_d,
+                drag_weight: *drag_weight,
+                coarse: None,
+            },
+            other => other.clone(),
+        }
+    }
+
+    /// `C_L - c_l_ref`, the lift's deviation from the undisturbed flow's mean (info `dC_L`), for
+    /// the gust reward; `None` for the rewards without a reference lift.
+    pub fn lift_deviation(&self, c_l: f64) -> Option<f64> {
+        match self {
+            RewardSpec::GustLoads { c_l_ref, .. } => Some(c_l - c_l_ref),
+            _ => None,
+        }
+    }
 }
 
 /// Observation normalisation `obs = (raw - mean) / scale`, computed by `hgym envs calibrate`

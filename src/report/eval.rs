@@ -57,6 +57,45 @@ pub struct EvalEpisode {
     /// Mean over steps of the sum of squared normalised actions.
     #[serde(deserialize_with = "nan_if_null")]
     pub actuation_cost: f64,
+    /// The gust flows' load figure (flows whose reward has a reference lift).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lift_deviation: Option<LiftDeviation>,
+}
+
+/// How far the lift strays from the undisturbed flow's mean over one episode, controlled and
+/// uncontrolled from the same state: the mean of |C_L - C_L,ref| (info `dC_L`), the lift term of
+/// the gust reward.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LiftDeviation {
+    #[serde(deserialize_with = "nan_if_null")]
+    pub mean_abs_dc_l: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub uncontrolled_abs_dc_l: f64,
+    /// `100 (1 - mean_abs_dc_l / uncontrolled_abs_dc_l)`.
+    #[serde(deserialize_with = "nan_if_null")]
+    pub reduction_pct: f64,
+}
+
+/// [`LiftDeviation`] over the evaluation's episodes.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LiftDeviationStat {
+    pub mean_abs_dc_l: Stat,
+    pub uncontrolled_abs_dc_l: Stat,
+    pub reduction_pct: Stat,
+}
+
+impl LiftDeviationStat {
+    /// Mean and std over `episodes` when every one has the figure.
+    pub fn of(episodes: &[EvalEpisode]) -> Option<Self> {
+        let figures: Option<Vec<LiftDeviation>> = episodes.iter().map(|e| e.lift_deviation).collect();
+        let figures = figures.filter(|f| !f.is_empty())?;
+        let col = |g: fn(&LiftDeviation) -> f64| Stat::of(&figures.iter().map(g).collect::<Vec<_>>());
+        Some(LiftDeviationStat {
+            mean_abs_dc_l: col(|f| f.mean_abs_dc_l),
+            uncontrolled_abs_dc_l: col(|f| f.uncontrolled_abs_dc_l),
+            reduction_pct: col(|f| f.reduction_pct),
+        })
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -73,4 +112,7 @@ pub struct EvalReport {
     pub drag_reduction_pct: Stat,
     pub mean_abs_c_l: Stat,
     pub actuation_cost: Stat,
+    /// The gust flows' load figure over the episodes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lift_deviation: Option<LiftDeviationStat>,
 }

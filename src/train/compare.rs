@@ -123,7 +123,7 @@ pub fn uncontrolled_return(env_id: &str, level: Level, config: &TrainConfig) -> 
     let n = config.train.eval_episodes.max(1);
     let seeds: Vec<u64> = (0..n as u64).map(|k| config.train.eval_seed + k).collect();
     let mut zero = hgym_agents::baselines::BaselinePolicy::new(hgym_agents::baselines::Baseline::Zero, 0);
-    let refs = vec![f64::NAN; n];
+    let refs = vec![super::eval::Uncontrolled::drag(f64::NAN); n];
     let hash = spec.hash();
     let r = evaluate(
         &mut env,

@@ -1,6 +1,7 @@
 //! Evaluation of any policy (trained actor or classical baseline) on an environment:
 //! return, mean C_D, drag reduction against the uncontrolled flow on the same episodes, mean
-//! |C_L| and actuation cost, as mean and standard deviation over episodes.
+//! |C_L| and actuation cost (and on the gusts the lift's deviation from the undisturbed mean), as
+//! mean and standard deviation over episodes.
 
 use std::path::Path;
 
@@ -11,24 +12,40 @@ use hgym_agents::rollout::{episode, EpisodeAccumulator, EpisodeStats};
 use crate::data::trajectory::TrajectoryWriter;
 use hgym_agents::{Env, EnvError};
 
-pub use crate::report::eval::{nan_if_null, EvalEpisode, EvalReport, Stat};
+pub use crate::report::eval::{nan_if_null, EvalEpisode, EvalReport, LiftDeviation, LiftDeviationStat, Stat};
 
-/// The mean C_D of each uncontrolled episode from `reset(seed)` for `seeds`.
-pub fn uncontrolled_c_d<E: Env + ?Sized>(env: &mut E, seeds: &[u64]) -> Result<Vec<f64>, EnvError> {
+/// What the uncontrolled flow does on one evaluation episode: the reference of the reductions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Uncontrolled {
+    /// Mean C_D.
+    pub c_d: f64,
+    /// Mean |C_L - C_L,ref| (info `dC_L`) on the flows whose reward has a reference lift.
+    pub abs_dc_l: Option<f64>,
+}
+
+impl Uncontrolled {
+    /// A reference with the drag only (the periodic evaluations' checkpointed one).
+    pub fn drag(c_d: f64) -> Self {
+        Uncontrolled { c_d, abs_dc_l: None }
+    }
+}
+
+/// The uncontrolled flow of each episode from `reset(seed)` for `seeds`.
+pub fn uncontrolled<E: Env + ?Sized>(env: &mut E, seeds: &[u64]) -> Result<Vec<Uncontrolled>, EnvError> {
     let mut zero = BaselinePolicy::new(Baseline::Zero, 0);
     seeds
         .iter()
         .map(|s| {
-            Ok(episode(env, &mut zero, *s, &mut |_, _| {})?
-                .info_means
-                .get("C_D")
-                .copied()
-                .unwrap_or(f64::NAN))
+            let means = episode(env, &mut zero, *s, &mut |_, _| {})?.info_means;
+            Ok(Uncontrolled {
+                c_d: means.get("C_D").copied().unwrap_or(f64::NAN),
+                abs_dc_l: means.get("abs_dC_L").copied(),
+            })
         })
         .collect()
 }
 
-/// Runs `policy` for one episode per seed; `reference` is the uncontrolled C_D per seed.
+/// Runs `policy` for one episode per seed; `reference` is the uncontrolled flow per seed.
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate<E: Env + crate::env::fields::FlowFields + ?Sized>(
     env: &mut E,
@@ -38,13 +55,13 @@ pub fn evaluate<E: Env + crate::env::fields::FlowFields + ?Sized>(
     spec_hash: &str,
     level: &str,
     seeds: &[u64],
-    reference: &[f64],
+    reference: &[Uncontrolled],
     mut trajectory: Option<&mut TrajectoryWriter>,
     progress: &mut dyn FnMut(usize),
 ) -> Result<EvalReport, EnvError> {
     let mut episodes = vec![];
     let io = |e: crate::data::DataError| EnvError::Backend(crate::report::chain(&e));
-    for (k, (seed, c_d0)) in seeds.iter().zip(reference).enumerate() {
+    for (k, (seed, uncontrolled)) in seeds.iter().zip(reference).enumerate() {
         let mut cost = 0.0;
         let (mut obs, mut info) = env.reset(*seed)?;
         if let Some(t) = trajectory.as_deref_mut() {
@@ -73,16 +90,27 @@ pub fn evaluate<E: Env + crate::env::fields::FlowFields + ?Sized>(
         }
         let stats: EpisodeStats = acc.finish();
         let mean_c_d = stats.info_means.get("C_D").copied().unwrap_or(f64::NAN);
+        let c_d0 = uncontrolled.c_d;
+        let lift_deviation = stats
+            .info_means
+            .get("abs_dC_L")
+            .zip(uncontrolled.abs_dc_l)
+            .map(|(&d, d0)| LiftDeviation {
+                mean_abs_dc_l: d,
+                uncontrolled_abs_dc_l: d0,
+                reduction_pct: 100.0 * (1.0 - d / d0),
+            });
         episodes.push(EvalEpisode {
             seed: *seed,
             ret: stats.ret,
             length: stats.length,
             terminated: stats.terminated,
             mean_c_d,
-            uncontrolled_c_d: *c_d0,
+            uncontrolled_c_d: c_d0,
             drag_reduction_pct: 100.0 * (1.0 - mean_c_d / c_d0),
             mean_abs_c_l: stats.info_means.get("abs_C_L").copied().unwrap_or(f64::NAN),
             actuation_cost: cost / stats.length.max(1) as f64,
+            lift_deviation,
         });
         progress(k + 1);
     }
@@ -99,6 +127,7 @@ pub fn evaluate<E: Env + crate::env::fields::FlowFields + ?Sized>(
         drag_reduction_pct: col(|e| e.drag_reduction_pct),
         mean_abs_c_l: col(|e| e.mean_abs_c_l),
         actuation_cost: col(|e| e.actuation_cost),
+        lift_deviation: LiftDeviationStat::of(&episodes),
         episodes,
     })
 }

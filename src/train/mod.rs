@@ -37,7 +37,7 @@ use serde::{Deserialize, Serialize};
 use self::checkpoint::Checkpoint;
 use self::config::TrainConfig;
 use self::curve::CurveRow;
-use self::eval::{evaluate, uncontrolled_c_d, EvalReport, Stat};
+use self::eval::{evaluate, uncontrolled, EvalReport, Stat, Uncontrolled};
 use crate::env::{FlowEnv, Spec};
 use crate::flow::Level;
 use crate::report::manifest::{manifest, Manifest};
@@ -222,6 +222,7 @@ pub fn train(
     let hash = spec.hash();
     // The periodic evaluation of the learner's current policy: the curve's eval columns.
     let periodic_eval = |env: &mut Box<dyn FlowEnv>, learner: &dyn Learner, reference: &[f64]| {
+        let reference: Vec<Uncontrolled> = reference.iter().map(|&c_d| Uncontrolled::drag(c_d)).collect();
         evaluate(
             env,
             &mut shared(learner.policy()),
@@ -230,7 +231,7 @@ pub fn train(
             &hash,
             opts.level.name(),
             &periodic_seeds,
-            reference,
+            &reference,
             None,
             &mut |_| {},
         )
@@ -243,7 +244,7 @@ pub fn train(
         }
         None => {
             let mut learner = algo.learner(&config.algos, obs_dim, act_dim, opts.seed)?;
-            let reference = uncontrolled_c_d(&mut eval_env, &periodic_seeds)?;
+            let reference: Vec<f64> = uncontrolled(&mut eval_env, &periodic_seeds)?.iter().map(|u| u.c_d).collect();
             let mut curve = vec![];
             if let Some(init) = &opts.init {
                 learner.init_actor(&init.policy)?;
@@ -352,7 +353,7 @@ pub fn train(
 
     // Final evaluation on its own seeds, against the uncontrolled flow from the same states.
     let final_seeds = eval_seeds(config, config.train.final_eval_episodes.max(1));
-    let final_ref = uncontrolled_c_d(&mut eval_env, &final_seeds)?;
+    let final_ref = uncontrolled(&mut eval_env, &final_seeds)?;
     let mut policy = shared(learner.policy());
     let hash = spec.hash();
     let mut trajectory = crate::data::trajectory::TrajectoryWriter::create(
@@ -462,6 +463,9 @@ pub struct SeedSummary {
     pub drag_reduction_pct: Stat,
     pub ret: Stat,
     pub mean_c_d: Stat,
+    /// The gust flows' lift deviation reduction (see [`eval::LiftDeviation`]) over seeds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lift_deviation_reduction_pct: Option<Stat>,
     pub runs: Vec<PathBuf>,
 }
 
@@ -476,6 +480,11 @@ pub fn summarize(env_id: &str, algo: &str, level: &str, runs: &[(u64, PathBuf, E
         drag_reduction_pct: col(|r| r.drag_reduction_pct.mean),
         ret: col(|r| r.ret.mean),
         mean_c_d: col(|r| r.mean_c_d.mean),
+        lift_deviation_reduction_pct: runs
+            .iter()
+            .map(|(_, _, r)| r.lift_deviation.map(|l| l.reduction_pct.mean))
+            .collect::<Option<Vec<f64>>>()
+            .map(|v| Stat::of(&v)),
         runs: runs.iter().map(|(_, p, _)| p.clone()).collect(),
     }
 }
