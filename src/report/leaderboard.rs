@@ -8,8 +8,9 @@
 //! policies of another flow evaluated zero-shot. Entries are grouped by (environment, level,
 //! algorithm or baseline; a fine-tuned or zero-shot policy by its source flow too); per entry:
 //! seeds, mean +- std over seeds of the drag reduction (for flows with a drag coefficient) and
-//! of the return, samples, wall time, code versions. Ranking: by drag reduction where there is
-//! one, else by return.
+//! of the return (and on the gust flows of the lift deviation reduction), samples, wall time,
+//! code versions. Ranking: by the lift deviation reduction on the gust flows, by drag reduction
+//! where there is one, else by return ([`Figure`]).
 //!
 //! An entry whose spec hash is not the one today's registry gives its runs (the registered spec
 //! with the run's `[env]` overrides) is *stale*: the environment it was trained on no longer
@@ -34,6 +35,10 @@ pub struct Entry {
     pub kind: String,
     pub seeds: usize,
     pub drag_reduction_pct: Stat,
+    /// Gust flows: the reduction of the lift's deviation from the undisturbed mean
+    /// (`LiftDeviation` of the evaluations), the figure they rank by.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lift_deviation_reduction_pct: Option<Stat>,
     pub ret: Stat,
     pub samples: Option<u64>,
     pub wall_time_s: Option<f64>,
@@ -120,12 +125,20 @@ fn read_eval(p: &Path) -> Result<Option<(EvalReport, serde_json::Value)>, String
     Ok(Some((report, manifest)))
 }
 
-/// `td3 zero-shot from Cylinder_2D_Re200` when an evaluation's `--policy` is a training run
-/// folder (relative to `root`) of another environment than `env_id`.
-fn zero_shot_source(root: &Path, policy: &str, env_id: &str) -> Option<String> {
+/// How an evaluation whose `--policy` is a training run folder (relative to `root`) is labelled:
+/// `td3 zero-shot from Cylinder_2D_Re200` for a run of another environment than `env_id`,
+/// `td3 trained at coarse` for a run of the same environment at another level than `level`.
+fn zero_shot_source(root: &Path, policy: &str, env_id: &str, level: &str) -> Option<String> {
     let source = read_json(&root.join(policy).join("manifest.json")).ok()?;
-    let (algo, from) = (source["algo"].as_str()?, source["env_id"].as_str()?);
-    (source["schema"] == "hgym/train/v1" && from != env_id).then(|| format!("{algo} zero-shot from {from}"))
+    let (algo, from, at) = (source["algo"].as_str()?, source["env_id"].as_str()?, source["level"].as_str()?);
+    if source["schema"] != "hgym/train/v1" {
+        return None;
+    }
+    if from != env_id {
+        Some(format!("{algo} zero-shot from {from}"))
+    } else {
+        (at != level).then(|| format!("{algo} trained at {at}"))
+    }
 }
 
 /// Every folder below `dir` holding a `metrics.json` of the evaluation schema; folders whose
@@ -167,7 +180,7 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<Run>, problems: &mut Vec<Probl
             (algo.to_string(), label, "learned")
         } else {
             let evaluated = manifest["policy"].as_str().unwrap_or(&report.policy).to_string();
-            match zero_shot_source(root, &evaluated, &report.env_id) {
+            match zero_shot_source(root, &evaluated, &report.env_id, &report.level) {
                 Some(label) => (evaluated, label, "zero-shot"),
                 None => (evaluated.clone(), evaluated, "baseline"),
             }
@@ -227,6 +240,11 @@ pub fn build(results: &Path, env: Option<&str>, current: CurrentHash, literature
                 kind: runs[0].kind.to_string(),
                 seeds: runs.len(),
                 drag_reduction_pct: col(&|r| r.report.drag_reduction_pct.mean),
+                lift_deviation_reduction_pct: runs
+                    .iter()
+                    .map(|r| r.report.lift_deviation.map(|l| l.reduction_pct.mean))
+                    .collect::<Option<Vec<f64>>>()
+                    .map(|v| Stat::of(&v)),
                 ret: col(&|r| r.report.ret.mean),
                 samples: (!samples.is_empty()).then(|| samples.iter().sum::<u64>() / samples.len() as u64),
                 wall_time_s: (!walls.is_empty()).then(|| walls.iter().sum::<f64>() / walls.len() as f64),
@@ -239,14 +257,7 @@ pub fn build(results: &Path, env: Option<&str>, current: CurrentHash, literature
             }
         })
         .collect();
-    let key = |e: &Entry| {
-        let d = e.drag_reduction_pct.mean;
-        if d.is_finite() {
-            d
-        } else {
-            e.ret.mean
-        }
-    };
+    let key = |e: &Entry| e.figure().of(e).mean;
     entries.sort_by(|a, b| {
         (a.stale, &a.env_id, &a.level, &a.spec_hash)
             .cmp(&(b.stale, &b.env_id, &b.level, &b.spec_hash))
@@ -256,6 +267,46 @@ pub fn build(results: &Path, env: Option<&str>, current: CurrentHash, literature
         schema: "hgym/leaderboard/v1".into(),
         entries,
         problems,
+    }
+}
+
+/// What an entry ranks by: the lift deviation reduction on the gust flows, else the drag
+/// reduction where there is a drag coefficient, else the return.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Figure {
+    LiftDeviationReduction,
+    DragReduction,
+    Return,
+}
+
+impl Figure {
+    /// The chart's axis label.
+    pub fn label(self) -> &'static str {
+        match self {
+            Figure::LiftDeviationReduction => "lift deviation reduction (%)",
+            Figure::DragReduction => "drag reduction (%)",
+            Figure::Return => "evaluation return",
+        }
+    }
+
+    /// The entry's value of this figure (NaN where it has none).
+    pub fn of(self, e: &Entry) -> Stat {
+        match self {
+            Figure::LiftDeviationReduction => e.lift_deviation_reduction_pct.unwrap_or(Stat::of(&[])),
+            Figure::DragReduction => e.drag_reduction_pct,
+            Figure::Return => e.ret,
+        }
+    }
+}
+
+impl Entry {
+    /// The figure this entry ranks by.
+    pub fn figure(&self) -> Figure {
+        match self.lift_deviation_reduction_pct {
+            Some(l) if l.mean.is_finite() => Figure::LiftDeviationReduction,
+            _ if self.drag_reduction_pct.mean.is_finite() => Figure::DragReduction,
+            _ => Figure::Return,
+        }
     }
 }
 
@@ -288,9 +339,14 @@ fn reproduce(env: &str, level: &str, runs: &[Run]) -> String {
             .map(|_| format!(" --config {}", first.dir.display()))
             .unwrap_or_default();
         let out = first.dir.parent().unwrap_or(Path::new("results/eval")).display();
+        // Several evaluated run folders (one per seed of a training): one command each.
+        let policies: Vec<&str> = runs.iter().map(|r| r.made_with.as_str()).collect();
+        let (head, policy, tail) = match policies.as_slice() {
+            [one] => (String::new(), one.to_string(), ""),
+            many => (format!("for p in {}; do ", many.join(" ")), "$p".to_string(), "; done"),
+        };
         return format!(
-            "hgym eval --env {env} --policy {} --res {level} --episodes {} --eval-seed {}{config} --out {out}",
-            first.made_with,
+            "{head}hgym eval --env {env} --policy {policy} --res {level} --episodes {} --eval-seed {}{config} --out {out}{tail}",
             first.episodes.unwrap_or(first.report.episodes.len() as u64),
             first.seed.unwrap_or(first.report.episodes.first().map_or(0, |e| e.seed)),
         );
@@ -332,10 +388,14 @@ pub fn markdown(lb: &Leaderboard) -> String {
     let mut s = String::from(
         "# hgym leaderboard\n\nGenerated by `hgym leaderboard` from the result folders under `results/`. \
          Drag reduction is against the uncontrolled flow of the same spec from the same initial states \
-         (deterministic evaluation); mean ± std over seeds (learners) or episodes' means (baselines: one entry).\n",
+         (deterministic evaluation); mean ± std over seeds (learners) or episodes' means (baselines: one entry). \
+         The gust flows rank by the lift deviation reduction, `100 (1 - mean |C_L - C_L,ref| / the uncontrolled flow's)` \
+         with C_L,ref the undisturbed flow's mean lift at that level.\n",
     );
     let mut last = (String::new(), String::new(), String::new());
     let mut rank = 0;
+    // Gust sections show the lift deviation reduction they rank by.
+    let mut lift = false;
     let mut stale_heading = false;
     let mut commands = String::new();
     for e in &lb.entries {
@@ -357,11 +417,18 @@ pub fn markdown(lb: &Leaderboard) -> String {
             if let Some(text) = &e.literature {
                 s += &format!("The uncontrolled flow at this level: {text}.\n\n");
             }
-            s += "| rank | policy | kind | seeds | drag reduction | return | samples | wall time | code |\n|---|---|---|---|---|---|---|---|---|\n";
+            lift = e.lift_deviation_reduction_pct.is_some();
+            let (head, rule) = if lift { ("lift deviation reduction | ", "---|") } else { ("", "") };
+            s += &format!("| rank | policy | kind | seeds | {head}drag reduction | return | samples | wall time | code |\n|---|---|---|---|{rule}---|---|---|---|---|\n");
         }
         rank += 1;
+        let lift_cell = match (lift, &e.lift_deviation_reduction_pct) {
+            (false, _) => String::new(),
+            (true, Some(l)) => format!("{} | ", fmt_stat(l, " %")),
+            (true, None) => "– | ".into(),
+        };
         s += &format!(
-            "| {rank} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            "| {rank} | {} | {} | {} | {lift_cell}{} | {} | {} | {} | {} |\n",
             e.policy,
             e.kind,
             e.seeds,
@@ -406,11 +473,12 @@ pub fn write(results: &Path, lb: &Leaderboard) -> Result<(), super::ReportError>
         by_env.entry((e.env_id.clone(), e.level.clone(), short)).or_default().push(e);
     }
     for ((env, level, short), es) in by_env {
-        let drag = es.iter().any(|e| e.drag_reduction_pct.mean.is_finite());
+        // The section's figure: the one its best entry ranks by (entries are sorted by it).
+        let figure = es[0].figure();
         let bars: Vec<(String, f64, f64)> = es
             .iter()
             .map(|e| {
-                let s = if drag { &e.drag_reduction_pct } else { &e.ret };
+                let s = figure.of(e);
                 (
                     e.policy.clone(),
                     if s.mean.is_finite() { s.mean } else { 0.0 },
@@ -421,7 +489,7 @@ pub fn write(results: &Path, lb: &Leaderboard) -> Result<(), super::ReportError>
         plots::bars(
             &dir.join(format!("{env}-{level}-{short}.png")),
             &format!("{env} ({level}, spec {short})"),
-            if drag { "drag reduction (%)" } else { "evaluation return" },
+            figure.label(),
             &bars,
         )?;
     }
