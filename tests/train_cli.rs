@@ -219,6 +219,53 @@ fn baselines_evaluate_against_the_uncontrolled_flow() {
     assert!(o.status.success(), "{}", text(&o));
     let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(r["actuation_cost"]["mean"].as_f64().unwrap() > 0.0);
+    assert!(r.get("lift_deviation").is_none(), "the cylinder's reward has no reference lift");
+}
+
+/// On a gust flow an evaluation says how far the lift strays from the undisturbed flow's mean,
+/// mean |C_L - C_L,ref| (info dC_L), under the policy and uncontrolled from the same states; a
+/// proportional controller on dC_L changes it, zero control is the reference itself.
+#[test]
+fn gust_evaluations_report_the_lift_deviation_against_the_uncontrolled_gust() {
+    let tmp = tempfile::tempdir().unwrap();
+    // 100 actions = 10 c/U: the gust reaches the leading edge after about 8.5.
+    let cfg = tmp.path().join("short.toml");
+    std::fs::write(&cfg, "[env]\nepisode_actions = 100\n").unwrap();
+    let eval = |policy: &str| -> serde_json::Value {
+        let o = hgym(&[
+            "eval",
+            "--policy",
+            policy,
+            "--env",
+            "NACA0012Gust_2D_Re1000_AoA20",
+            "--episodes",
+            "1",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--json",
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let zero = eval("zero");
+    let l = &zero["lift_deviation"];
+    let d0 = l["uncontrolled_abs_dc_l"]["mean"].as_f64().unwrap();
+    assert!(d0 > 0.05, "the gust moves the lift: {l}");
+    assert_eq!(l["mean_abs_dc_l"]["mean"].as_f64(), Some(d0));
+    assert_eq!(l["reduction_pct"]["mean"].as_f64(), Some(0.0));
+    let pd = eval("pd=dC_L,-0.6,0");
+    let l = &pd["lift_deviation"];
+    let (d, pct) = (
+        l["mean_abs_dc_l"]["mean"].as_f64().unwrap(),
+        l["reduction_pct"]["mean"].as_f64().unwrap(),
+    );
+    assert_eq!(
+        l["uncontrolled_abs_dc_l"]["mean"].as_f64(),
+        Some(d0),
+        "the same uncontrolled episode"
+    );
+    assert!(d != d0 && (pct - 100.0 * (1.0 - d / d0)).abs() < 1e-9, "{l}");
+    assert_eq!(pd["episodes"][0]["lift_deviation"]["reduction_pct"].as_f64(), Some(pct));
 }
 
 /// Hostile overrides and arguments (issue 36): each is refused at once with exit 2, naming the
