@@ -138,6 +138,30 @@ fn leaderboard_rebuilds_the_committed_one_from_the_committed_results() {
         .unwrap();
     let printed = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success() && printed.contains("steps = 30000"), "{printed}");
+    // The gust flow ranks by the lift deviation reduction, which its section shows, and the
+    // P controller on dC_L (+9.9 %) is above TD3 (+0.6 %) there.
+    let gust: Vec<&serde_json::Value> = entries
+        .iter()
+        .filter(|e| e["env_id"] == "NACA0012Gust_2D_Re1000_AoA20" && e["level"] == "coarse")
+        .collect();
+    let lift = |e: &serde_json::Value| e["lift_deviation_reduction_pct"]["mean"].as_f64().unwrap();
+    let rank = |policy: &str| gust.iter().position(|e| e["policy"] == policy).unwrap();
+    assert!(gust.iter().all(|e| lift(e).is_finite()), "{gust:?}");
+    assert_eq!(gust[rank("td3")]["seeds"], 5);
+    assert!(rank("pd=dC_L,-0.6,0") < rank("td3") && lift(gust[0]) >= lift(gust[gust.len() - 1]));
+    assert!(md.contains("| rank | policy | kind | seeds | lift deviation reduction | drag reduction |"));
+    // The coarse-trained cylinder policies evaluated at default: one entry per algorithm, its
+    // three seeds together, reproduced by one loop over the run folders.
+    let moved = entries
+        .iter()
+        .find(|e| e["env_id"] == "Cylinder_2D_Re100" && e["level"] == "default" && e["policy"] == "td3 trained at coarse")
+        .expect("the coarse TD3 policies at default");
+    assert_eq!((moved["kind"].as_str(), moved["seeds"].as_u64()), (Some("zero-shot"), Some(3)));
+    let command = moved["reproduce"].as_str().unwrap();
+    assert!(
+        command.starts_with("for p in results/train/Cylinder_2D_Re100-td3-coarse/seed0 ") && command.contains("--policy $p --res default"),
+        "{command}"
+    );
 }
 
 /// A folder whose metrics.json is damaged is listed as a problem row (JSON, markdown, a warning
