@@ -83,7 +83,9 @@ fn total_drag_lift_reward_of_the_pinball() {
 }
 
 /// Gust aerofoil: `r = -|C_L - C_L,ref| - w |C_D - C_D,ref|`, in the first interval (before the
-/// gust reaches the inlet, so the twin's steady inlet is the environment's).
+/// gust reaches the inlet, so the twin's steady inlet is the environment's), with the references
+/// of the level run: at coarse the spec's `coarse` pair, the undisturbed coarse flow's mean
+/// forces. `info["dC_L"]` is `C_L - C_L,ref`.
 #[test]
 fn gust_loads_reward_of_the_aerofoil() {
     let id = "NACA0012Gust_2D_Re1000_AoA20";
@@ -91,15 +93,16 @@ fn gust_loads_reward_of_the_aerofoil() {
     let [c_d, c_l] = f[0];
     assert!(close(info(&r, "C_D"), c_d) && close(info(&r, "C_L"), c_l));
     let hgym::env::spec::RewardSpec::GustLoads {
-        c_l_ref,
-        c_d_ref,
         drag_weight,
+        coarse: Some([c_l_ref, c_d_ref]),
+        ..
     } = spec(id).unwrap().reward
     else {
-        panic!("the gust reward kind changed");
+        panic!("the gust reward kind changed, or it lost its coarse references");
     };
     let expected = -(c_l - c_l_ref).abs() - drag_weight * (c_d - c_d_ref).abs();
     assert!(close(r.reward, expected), "reward {} vs {expected}", r.reward);
+    assert!(close(info(&r, "dC_L"), c_l - c_l_ref));
 }
 
 /// Open cavity: `r = -sum_i ((o_i - mean_i) / std_i)^2`, i.e. `-9 sum obs^2` with the 3-std
