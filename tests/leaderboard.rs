@@ -151,15 +151,17 @@ fn leaderboard_rebuilds_the_committed_one_from_the_committed_results() {
     assert!(rank("pd=dC_L,-0.6,0") < rank("td3") && lift(gust[0]) >= lift(gust[gust.len() - 1]));
     assert!(md.contains("| rank | policy | kind | seeds | lift deviation reduction | drag reduction |"));
     // The coarse-trained cylinder policies evaluated at default: one entry per algorithm, its
-    // three seeds together, reproduced by one loop over the run folders.
+    // three seeds together, reproduced by one command per run folder.
     let moved = entries
         .iter()
         .find(|e| e["env_id"] == "Cylinder_2D_Re100" && e["level"] == "default" && e["policy"] == "td3 trained at coarse")
         .expect("the coarse TD3 policies at default");
     assert_eq!((moved["kind"].as_str(), moved["seeds"].as_u64()), (Some("zero-shot"), Some(3)));
     let command = moved["reproduce"].as_str().unwrap();
+    let eval =
+        |s: u64| format!("hgym eval --env Cylinder_2D_Re100 --policy results/train/Cylinder_2D_Re100-td3-coarse/seed{s} --res default");
     assert!(
-        command.starts_with("for p in results/train/Cylinder_2D_Re100-td3-coarse/seed0 ") && command.contains("--policy $p --res default"),
+        command.starts_with(&eval(0)) && command.contains(&format!(" && {}", eval(1))) && command.contains(&format!(" && {}", eval(2))),
         "{command}"
     );
 }

@@ -340,16 +340,18 @@ fn reproduce(env: &str, level: &str, runs: &[Run]) -> String {
             .unwrap_or_default();
         let out = first.dir.parent().unwrap_or(Path::new("results/eval")).display();
         // Several evaluated run folders (one per seed of a training): one command each.
-        let policies: Vec<&str> = runs.iter().map(|r| r.made_with.as_str()).collect();
-        let (head, policy, tail) = match policies.as_slice() {
-            [one] => (String::new(), one.to_string(), ""),
-            many => (format!("for p in {}; do ", many.join(" ")), "$p".to_string(), "; done"),
-        };
-        return format!(
-            "{head}hgym eval --env {env} --policy {policy} --res {level} --episodes {} --eval-seed {}{config} --out {out}{tail}",
-            first.episodes.unwrap_or(first.report.episodes.len() as u64),
-            first.seed.unwrap_or(first.report.episodes.first().map_or(0, |e| e.seed)),
-        );
+        return runs
+            .iter()
+            .map(|r| {
+                format!(
+                    "hgym eval --env {env} --policy {} --res {level} --episodes {} --eval-seed {}{config} --out {out}",
+                    r.made_with,
+                    first.episodes.unwrap_or(first.report.episodes.len() as u64),
+                    first.seed.unwrap_or(first.report.episodes.first().map_or(0, |e| e.seed)),
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(" && ");
     }
     let mut seeds: Vec<u64> = runs.iter().filter_map(|r| r.seed).collect();
     seeds.sort();
