@@ -130,23 +130,19 @@ pub fn reference_coefficients(re: u32, aoa: u32) -> Option<(f64, f64)> {
     }
 }
 
-/// Time-averaged (C_L, C_D) of the undisturbed flow at the coarse level (entries
+/// Time-averaged (C_L, C_D) of the undisturbed flow at the coarse level (entry
 /// `NACA0012_2D_Re{re}_AoA{aoa}@coarse` of the same table, 100 actions): the gust reward's
 /// references at coarse. At 16 cells per chord the separated flow has other mean forces (the mean
 /// lift at Re 1000 and 20 degrees is 0.57 against 0.88), so against the default level's
 /// references the coarse reward would pay for shifting the mean lift, not for answering the gust.
 pub fn coarse_reference_coefficients(re: u32, aoa: u32) -> Option<(f64, f64)> {
-    match (re, aoa) {
-        // Calibrated 2026-12-05 (coarse level, 100 actions): C_D 0.3927, C_L 0.5722.
-        (1000, 20) => Some((0.5722359442177729, 0.3926538318416277)),
-        // Calibrated 2026-11-23 (coarse level, 100 actions): C_D 0.5636, C_L 0.6555.
-        (100, 20) => Some((0.6555142897473992, 0.5636415095297891)),
-        // Calibrated 2026-11-23 (coarse level, 100 actions): C_D 1.0376, C_L 0.8793.
-        (100, 40) => Some((0.8792870194973718, 1.0375862365790434)),
-        // Calibrated 2026-11-23 (coarse level, 100 actions): C_D 1.2465, C_L 1.1031.
-        (1000, 40) => Some((1.103061532342931, 1.2465228738230816)),
-        _ => None,
-    }
+    calibrated_forces(&format!("NACA0012_2D_Re{re}_AoA{aoa}@coarse"))
+}
+
+/// The uncontrolled mean (C_L, C_D) that `hgym envs calibrate` committed under `key`.
+fn calibrated_forces(key: &str) -> Option<(f64, f64)> {
+    let [c_d, c_l] = super::calibrate::table().get(key)?.mean_forces?;
+    Some((c_l, c_d))
 }
 
 /// `NACA0012_2D_Re{re}_AoA{aoa}`: the paper's 2D bluff-body set-up (inflow, periodic sides,
@@ -241,11 +237,7 @@ pub fn steady_3d(re: u32, aoa: u32) -> super::spec3::Env3Spec {
 /// million nodes) has not been calibrated; its flow differs, so its rewards carry the coarse
 /// references' offset.
 pub fn reference_coefficients_3d(re: u32, aoa: u32) -> Option<(f64, f64)> {
-    match (re, aoa) {
-        // Calibrated 2026-11-27 (coarse level, 100 actions): C_D 0.3898, C_L 0.5785.
-        (1000, 20) => Some((0.5784674983351564, 0.3897719155324764)),
-        _ => None,
-    }
+    calibrated_forces(&format!("NACA0012_3D_Re{re}_AoA{aoa}@coarse"))
 }
 
 /// `NACA0012Gust_3D_Re{re}_AoA{aoa}` (the paper's main-text gust case at Re 1000, 20 degrees):
@@ -275,28 +267,21 @@ mod tests {
     use hgym_solvers::geometry::{Naca4, Shape};
 
     /// The gust rewards' references are the committed calibrations of the undisturbed flows:
-    /// `ID` (default level, recorded to four decimals), `ID@coarse` (coarse level; the 3D gust's
-    /// references), in full.
+    /// `ID` (default level, typed to the four decimals it was recorded at); every gust flow has its
+    /// coarse references (`ID@coarse`), and the 3D gust its own.
     #[test]
     fn gust_references_are_the_undisturbed_flows_calibrations() {
         let table = crate::env::calibrate::table();
-        let forces = |key: &str| {
-            let [c_d, c_l] = table[key].mean_forces.unwrap_or_else(|| panic!("{key} has no mean forces"));
-            (c_l, c_d)
-        };
-        let four_decimals = |(c_l, c_d): (f64, f64)| ((c_l * 1e4).round() / 1e4, (c_d * 1e4).round() / 1e4);
+        let four_decimals = |[c_d, c_l]: [f64; 2]| ((c_l * 1e4).round() / 1e4, (c_d * 1e4).round() / 1e4);
         for re in REYNOLDS {
             for aoa in ANGLES {
                 let id = format!("NACA0012_2D_Re{re}_AoA{aoa}");
-                assert_eq!(reference_coefficients(re, aoa), Some(four_decimals(forces(&id))), "{id}");
-                assert_eq!(
-                    coarse_reference_coefficients(re, aoa),
-                    Some(forces(&format!("{id}@coarse"))),
-                    "{id}@coarse"
-                );
+                let forces = table[&id].mean_forces.unwrap_or_else(|| panic!("{id} has no mean forces"));
+                assert_eq!(reference_coefficients(re, aoa), Some(four_decimals(forces)), "{id}");
+                assert!(coarse_reference_coefficients(re, aoa).is_some(), "{id}@coarse is not calibrated");
             }
         }
-        assert_eq!(reference_coefficients_3d(1000, 20), Some(forces("NACA0012_3D_Re1000_AoA20@coarse")));
+        assert!(reference_coefficients_3d(1000, 20).is_some());
     }
 
     /// At coarse the gust environment's reward and `dC_L` use the coarse references.

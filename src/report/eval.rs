@@ -96,6 +96,16 @@ impl LiftDeviationStat {
             reduction_pct: col(|f| f.reduction_pct),
         })
     }
+
+    /// The reduction's mean and std over several evaluations (seeds) of the per-evaluation means,
+    /// when every one has the figure.
+    pub fn reduction_over<'a>(reports: impl IntoIterator<Item = &'a EvalReport>) -> Option<Stat> {
+        let means: Option<Vec<f64>> = reports
+            .into_iter()
+            .map(|r| r.lift_deviation.map(|l| l.reduction_pct.mean))
+            .collect();
+        means.map(|v| Stat::of(&v))
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

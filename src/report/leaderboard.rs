@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::report::eval::{EvalReport, Stat};
+use crate::report::eval::{EvalReport, LiftDeviationStat, Stat};
 use crate::report::plots;
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -240,11 +240,7 @@ pub fn build(results: &Path, env: Option<&str>, current: CurrentHash, literature
                 kind: runs[0].kind.to_string(),
                 seeds: runs.len(),
                 drag_reduction_pct: col(&|r| r.report.drag_reduction_pct.mean),
-                lift_deviation_reduction_pct: runs
-                    .iter()
-                    .map(|r| r.report.lift_deviation.map(|l| l.reduction_pct.mean))
-                    .collect::<Option<Vec<f64>>>()
-                    .map(|v| Stat::of(&v)),
+                lift_deviation_reduction_pct: LiftDeviationStat::reduction_over(runs.iter().map(|r| &r.report)),
                 ret: col(&|r| r.report.ret.mean),
                 samples: (!samples.is_empty()).then(|| samples.iter().sum::<u64>() / samples.len() as u64),
                 wall_time_s: (!walls.is_empty()).then(|| walls.iter().sum::<f64>() / walls.len() as f64),

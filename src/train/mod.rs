@@ -37,7 +37,7 @@ use serde::{Deserialize, Serialize};
 use self::checkpoint::Checkpoint;
 use self::config::TrainConfig;
 use self::curve::CurveRow;
-use self::eval::{evaluate, uncontrolled, EvalReport, Stat, Uncontrolled};
+use self::eval::{evaluate, uncontrolled, EvalReport, LiftDeviationStat, Stat, Uncontrolled};
 use crate::env::{FlowEnv, Spec};
 use crate::flow::Level;
 use crate::report::manifest::{manifest, Manifest};
@@ -480,11 +480,7 @@ pub fn summarize(env_id: &str, algo: &str, level: &str, runs: &[(u64, PathBuf, E
         drag_reduction_pct: col(|r| r.drag_reduction_pct.mean),
         ret: col(|r| r.ret.mean),
         mean_c_d: col(|r| r.mean_c_d.mean),
-        lift_deviation_reduction_pct: runs
-            .iter()
-            .map(|(_, _, r)| r.lift_deviation.map(|l| l.reduction_pct.mean))
-            .collect::<Option<Vec<f64>>>()
-            .map(|v| Stat::of(&v)),
+        lift_deviation_reduction_pct: LiftDeviationStat::reduction_over(runs.iter().map(|(_, _, r)| r)),
         runs: runs.iter().map(|(_, p, _)| p.clone()).collect(),
     }
 }
