@@ -123,8 +123,10 @@ type Obs<'py> = Bound<'py, PyArray1<f32>>;
 type Bounds<'py> = (Obs<'py>, Obs<'py>);
 type Infos<'py> = Vec<Bound<'py, PyDict>>;
 
+/// `obs` narrowed to float32, copied into an array numpy allocates (an array made from a Rust
+/// `Vec` would need a Python object of its own to keep the `Vec` alive).
 fn obs_array<'py>(py: Python<'py>, obs: &[f64]) -> Bound<'py, PyArray1<f32>> {
-    PyArray1::from_iter(py, obs.iter().map(|&v| v as f32))
+    PyArray1::from_slice(py, &obs.iter().map(|&v| v as f32).collect::<Vec<_>>())
 }
 
 fn bounds<'py>(py: Python<'py>, space: &hgym_agents::BoxSpace) -> Bounds<'py> {
@@ -235,19 +237,12 @@ impl Env {
         action: &Bound<'py, PyAny>,
     ) -> PyResult<(Bound<'py, PyArray1<f32>>, f64, bool, bool, Bound<'py, PyDict>)> {
         let not_flat = |e: numpy::AsSliceError| PyTypeError::new_err(format!("the action: {e}"));
-        let (doubles, singles, widened);
-        let action: &[f64] = if let Ok(a) = action.cast::<PyArray1<f64>>() {
-            doubles = a.readonly();
-            doubles.as_slice().map_err(not_flat)?
+        // Copied under the GIL (a few numbers): no borrow of the array outlives this line, so
+        // none needs registering with numpy's borrow checker while the solver steps.
+        let action: Vec<f64> = if let Ok(a) = action.cast::<PyArray1<f64>>() {
+            a.to_vec().map_err(not_flat)?
         } else if let Ok(a) = action.cast::<PyArray1<f32>>() {
-            singles = a.readonly();
-            widened = singles
-                .as_slice()
-                .map_err(not_flat)?
-                .iter()
-                .map(|&v| f64::from(v))
-                .collect::<Vec<_>>();
-            &widened
+            a.to_vec().map_err(not_flat)?.into_iter().map(f64::from).collect()
         } else {
             return Err(PyTypeError::new_err("the action must be a 1-D numpy array of float32 or float64"));
         };
@@ -255,7 +250,7 @@ impl Env {
         let env: &mut dyn FlowEnv = &mut **guard;
         let (r, ns) = detached(py, || {
             let t = Instant::now();
-            let r = env.step(action);
+            let r = env.step(&action);
             (r, t.elapsed().as_nanos() as u64)
         })?;
         self.step_ns.fetch_add(ns, Ordering::Relaxed);
@@ -345,7 +340,7 @@ impl VecEnv {
 /// Rows of `rows` (all of length `width`) as a float32 matrix.
 fn matrix<'a, 'py>(py: Python<'py>, rows: impl ExactSizeIterator<Item = &'a [f64]>, width: usize) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let n = rows.len();
-    PyArray1::from_iter(py, rows.flat_map(|r| r.iter().map(|&v| v as f32)))
+    PyArray1::from_slice(py, &rows.flat_map(|r| r.iter().map(|&v| v as f32)).collect::<Vec<_>>())
         .reshape([n, width])
         .map_err(|e| PyRuntimeError::new_err(e.to_string()))
 }
