@@ -91,6 +91,18 @@ fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
     assert!(o.status.success(), "{}", text(&o));
     assert!(text(&o).contains("finished already"), "{}", text(&o));
     assert_eq!(read(&run.join("metrics.json")), before);
+    // A run recorded before a configuration field existed (the field at its default) is the
+    // same set-up, kept too.
+    let manifest_path = run.join("manifest.json");
+    let recorded = read(&manifest_path);
+    let mut older: serde_json::Value = serde_json::from_str(&recorded).unwrap();
+    let toml = older["config_toml"].as_str().unwrap().replace("fields_every = 0\n", "");
+    assert_ne!(Some(toml.as_str()), older["config_toml"].as_str());
+    older["config_toml"] = toml.into();
+    std::fs::write(&manifest_path, older.to_string()).unwrap();
+    let o = hgym(&td3_args(&cfg, &full));
+    assert!(text(&o).contains("finished already"), "{}", text(&o));
+    std::fs::write(&manifest_path, recorded).unwrap();
     let mut other = td3_args(&cfg, &full);
     other[6] = "2000";
     let o = hgym(&other);

@@ -747,13 +747,18 @@ pub fn finished_run(opts: &TrainOptions) -> Result<Option<EvalReport>> {
         ("algo", serde_json::json!(opts.algo)),
         ("seed", serde_json::json!(opts.seed)),
         ("level", serde_json::json!(opts.level.name())),
-        ("config_toml", serde_json::json!(opts.config.to_toml())),
     ];
     let mut differ: Vec<&str> = expected
         .iter()
         .filter(|(key, value)| manifest.get(*key) != Some(value))
         .map(|(key, _)| *key)
         .collect();
+    // Compared as parsed, so a field added since the run (at its default) or another order of
+    // the text is the same set-up.
+    let config = manifest["config_toml"].as_str().and_then(|text| TrainConfig::parse(text, "").ok());
+    if config.as_ref() != Some(&opts.config) {
+        differ.push("config_toml");
+    }
     if manifest.get("init_from").is_some() != opts.init.is_some() {
         differ.push("init_from");
     }
