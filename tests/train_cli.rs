@@ -28,7 +28,8 @@ fn config(dir: &Path) -> PathBuf {
 }
 
 /// `hgym train` of TD3 on the cylinder for 1600 samples (4 rounds) with the config `cfg`.
-fn td3_args<'a>(cfg: &'a Path, out: &'a Path) -> [&'a str; 11] {
+/// One worker thread, not the machine's default, so a resume must find the count in the checkpoint.
+fn td3_args<'a>(cfg: &'a Path, out: &'a Path) -> [&'a str; 13] {
     let (cfg, out) = (cfg.to_str().unwrap(), out.to_str().unwrap());
     [
         "train",
@@ -42,6 +43,8 @@ fn td3_args<'a>(cfg: &'a Path, out: &'a Path) -> [&'a str; 11] {
         cfg,
         "--out",
         out,
+        "--threads",
+        "1",
     ]
 }
 
@@ -102,6 +105,13 @@ fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
     std::fs::write(&manifest_path, older.to_string()).unwrap();
     let o = hgym(&td3_args(&cfg, &full));
     assert!(text(&o).contains("finished already"), "{}", text(&o));
+    // A recorded configuration that no longer parses is named as such, with the manifest.
+    older["config_toml"] = "[train]\nno_such_field = 1\n".into();
+    std::fs::write(&manifest_path, older.to_string()).unwrap();
+    let o = hgym(&td3_args(&cfg, &full));
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("no longer parses"), "{}", text(&o));
+    assert!(text(&o).contains("manifest.json"), "{}", text(&o));
     std::fs::write(&manifest_path, recorded).unwrap();
     let mut other = td3_args(&cfg, &full);
     other[6] = "2000";
@@ -150,6 +160,8 @@ fn train_writes_a_result_folder_and_resume_after_ctrl_c_is_bitwise_identical() {
         "resumed metrics differ"
     );
     assert_eq!(read(&cut_run.join("curve.csv")).lines().count(), 5);
+    let resumed: serde_json::Value = serde_json::from_str(&read(&cut_run.join("manifest.json"))).unwrap();
+    assert_eq!(resumed["manifest"]["threads"], 1, "a resume keeps the run's thread count");
 
     // The trained policy evaluates through `hgym eval`, and is refused on a flow of another shape.
     let o = hgym(&[

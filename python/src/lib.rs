@@ -11,7 +11,8 @@ use std::time::Instant;
 use hgym::env::{FlowEnv, Spec};
 use hgym::flow::Level;
 use hgym_agents::{EnvError, Info};
-use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::ndarray::{Dimension, IntoDimension};
+use numpy::{PyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
@@ -123,14 +124,27 @@ type Obs<'py> = Bound<'py, PyArray1<f32>>;
 type Bounds<'py> = (Obs<'py>, Obs<'py>);
 type Infos<'py> = Vec<Bound<'py, PyDict>>;
 
-/// `obs` narrowed to float32, copied into an array numpy allocates (an array made from a Rust
-/// `Vec` would need a Python object of its own to keep the `Vec` alive).
-fn obs_array<'py>(py: Python<'py>, obs: &[f64]) -> Bound<'py, PyArray1<f32>> {
-    PyArray1::from_slice(py, &obs.iter().map(|&v| v as f32).collect::<Vec<_>>())
+/// A float32 array of shape `dims` that numpy allocates, written in place from `values`
+/// (narrowed from f64): no buffer in between, and no Python object of its own to keep a Rust
+/// `Vec` alive as an array made from one would need.
+fn f32_array<'py, D: Dimension>(
+    py: Python<'py>,
+    dims: impl IntoDimension<Dim = D>,
+    values: impl Iterator<Item = f64>,
+) -> PyResult<Bound<'py, PyArray<f32, D>>> {
+    let a = PyArray::<f32, D>::zeros(py, dims, false);
+    for (slot, v) in a.try_readwrite()?.as_slice_mut()?.iter_mut().zip(values) {
+        *slot = v as f32;
+    }
+    Ok(a)
 }
 
-fn bounds<'py>(py: Python<'py>, space: &hgym_agents::BoxSpace) -> Bounds<'py> {
-    (obs_array(py, &space.low), obs_array(py, &space.high))
+fn obs_array<'py>(py: Python<'py>, obs: &[f64]) -> PyResult<Obs<'py>> {
+    f32_array(py, obs.len(), obs.iter().copied())
+}
+
+fn bounds<'py>(py: Python<'py>, space: &hgym_agents::BoxSpace) -> PyResult<Bounds<'py>> {
+    Ok((obs_array(py, &space.low)?, obs_array(py, &space.high)?))
 }
 
 /// One environment. The Python class `hgym.HgymEnv` wraps it with Gymnasium's API.
@@ -211,12 +225,12 @@ impl Env {
 
     /// `(low, high)` of the observation space, float32.
     fn observation_bounds<'py>(&self, py: Python<'py>) -> PyResult<Bounds<'py>> {
-        Ok(bounds(py, &self.env()?.observation_space()))
+        bounds(py, &self.env()?.observation_space())
     }
 
     /// `(low, high)` of the action space, float32.
     fn action_bounds<'py>(&self, py: Python<'py>) -> PyResult<Bounds<'py>> {
-        Ok(bounds(py, &self.env()?.action_space()))
+        bounds(py, &self.env()?.action_space())
     }
 
     /// `reset(seed) -> (obs, info)`; the first reset of a flow spins it up (cached on disk).
@@ -224,7 +238,7 @@ impl Env {
         let mut guard = self.env()?;
         let env: &mut dyn FlowEnv = &mut **guard;
         let (obs, info) = detached(py, || env.reset(seed))?.map_err(env_error)?;
-        Ok((obs_array(py, &obs), self.keys.dict(py, &info)?))
+        Ok((obs_array(py, &obs)?, self.keys.dict(py, &info)?))
     }
 
     /// `step(action) -> (obs, reward, terminated, truncated, info)`; `action` a contiguous 1-D
@@ -256,7 +270,7 @@ impl Env {
         self.step_ns.fetch_add(ns, Ordering::Relaxed);
         let r = r.map_err(env_error)?;
         Ok((
-            obs_array(py, &r.obs),
+            obs_array(py, &r.obs)?,
             r.reward,
             r.terminated,
             r.truncated,
@@ -339,10 +353,7 @@ impl VecEnv {
 
 /// Rows of `rows` (all of length `width`) as a float32 matrix.
 fn matrix<'a, 'py>(py: Python<'py>, rows: impl ExactSizeIterator<Item = &'a [f64]>, width: usize) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let n = rows.len();
-    PyArray1::from_slice(py, &rows.flat_map(|r| r.iter().map(|&v| v as f32)).collect::<Vec<_>>())
-        .reshape([n, width])
-        .map_err(|e| PyRuntimeError::new_err(e.to_string()))
+    f32_array(py, [rows.len(), width], rows.flat_map(|r| r.iter().copied()))
 }
 
 #[pymethods]
@@ -398,12 +409,12 @@ impl VecEnv {
 
     /// `(low, high)` of one instance's observation space, float32.
     fn observation_bounds<'py>(&self, py: Python<'py>) -> PyResult<Bounds<'py>> {
-        Ok(bounds(py, &self.envs()?[0].observation_space()))
+        bounds(py, &self.envs()?[0].observation_space())
     }
 
     /// `(low, high)` of one instance's action space, float32.
     fn action_bounds<'py>(&self, py: Python<'py>) -> PyResult<Bounds<'py>> {
-        Ok(bounds(py, &self.envs()?[0].action_space()))
+        bounds(py, &self.envs()?[0].action_space())
     }
 
     /// `step(actions [n, act_dim], resets) -> (obs, rewards, terminated, truncated, infos)`.

@@ -6,6 +6,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use anyhow::{Context, Result};
 use clap::Args;
 use hgym::flow::Level;
+use hgym::train::checkpoint::Checkpoint;
 use hgym::train::config::TrainConfig;
 use hgym::train::eval::{evaluate, parse_policy, uncontrolled, EvalReport, LiftDeviationStat, NamedPolicy};
 use hgym::train::{resolve_spec, resume_options, summarize, Ending, Init, TrainError, TrainOptions};
@@ -81,7 +82,8 @@ pub struct TrainArgs {
     /// Print the final metrics as JSON.
     #[arg(long)]
     json: bool,
-    /// Worker threads (default: all cores); results are bitwise repeatable for the same seed and thread count.
+    /// Worker threads (default: all cores; with --resume, the count the run ran on); results are bitwise
+    /// repeatable for the same seed and thread count.
     #[arg(long)]
     threads: Option<usize>,
 }
@@ -298,11 +300,16 @@ pub fn run_train(args: TrainArgs) -> Result<Outcome> {
         print!("{}", config.to_toml());
         return Ok(Outcome::Ok);
     }
-    let (pool, threads) = thread_pool(args.threads)?;
-    install_interrupt();
     let cache = hgym::env::default_cache_dir();
-    let jobs: Vec<(TrainOptions, Option<hgym::train::checkpoint::Checkpoint>)> = if let Some(dir) = &args.resume {
-        let (opts, ck) = resume_options(dir, args.steps, cache).map_err(train_error)?;
+    let resumed = match &args.resume {
+        Some(dir) => Some(resume_options(dir, args.steps, cache.clone()).map_err(train_error)?),
+        None => None,
+    };
+    // A resumed run keeps the thread count it ran on, unless told otherwise.
+    let (pool, threads) = thread_pool(args.threads.or(resumed.as_ref().and_then(|(_, ck)| ck.threads)))?;
+    install_interrupt();
+    let jobs: Vec<(TrainOptions, Option<Checkpoint>)> = if let Some((opts, ck)) = resumed {
+        note_threads(&opts, &ck, threads);
         eprintln!(
             "resuming {} {} seed {} at {} samples (round {})",
             opts.env_id,
@@ -740,7 +747,8 @@ pub fn finished_run(opts: &TrainOptions) -> Result<Option<EvalReport>> {
         let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
         serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))
     };
-    let manifest = read(&opts.out.join("manifest.json"))?;
+    let manifest_path = opts.out.join("manifest.json");
+    let manifest = read(&manifest_path)?;
     let spec = resolve_spec(&opts.env_id, &opts.config).map_err(train_error)?;
     let expected = [
         ("spec_hash", serde_json::json!(spec.hash())),
@@ -748,19 +756,22 @@ pub fn finished_run(opts: &TrainOptions) -> Result<Option<EvalReport>> {
         ("seed", serde_json::json!(opts.seed)),
         ("level", serde_json::json!(opts.level.name())),
     ];
-    let mut differ: Vec<&str> = expected
+    let mut differ: Vec<String> = expected
         .iter()
         .filter(|(key, value)| manifest.get(*key) != Some(value))
-        .map(|(key, _)| *key)
+        .map(|(key, _)| key.to_string())
         .collect();
     // Compared as parsed, so a field added since the run (at its default) or another order of
     // the text is the same set-up.
-    let config = manifest["config_toml"].as_str().and_then(|text| TrainConfig::parse(text, "").ok());
-    if config.as_ref() != Some(&opts.config) {
-        differ.push("config_toml");
+    let origin = format!("{} (config_toml)", manifest_path.display());
+    match manifest["config_toml"].as_str().map(|text| TrainConfig::parse(text, &origin)) {
+        Some(Ok(config)) if config == opts.config => {}
+        Some(Ok(_)) => differ.push("config_toml".into()),
+        Some(Err(e)) => differ.push(format!("config_toml, which no longer parses: {e}")),
+        None => differ.push(format!("config_toml, which {} lacks", manifest_path.display())),
     }
     if manifest.get("init_from").is_some() != opts.init.is_some() {
-        differ.push("init_from");
+        differ.push("init_from".into());
     }
     if !differ.is_empty() {
         return Err(UsageError(format!(
@@ -775,6 +786,18 @@ pub fn finished_run(opts: &TrainOptions) -> Result<Option<EvalReport>> {
     Ok(Some(report))
 }
 
+/// Says when a run continues on another thread count than its checkpoint was written on: the
+/// result stays valid but is no longer bitwise the one an uninterrupted run gives.
+fn note_threads(opts: &TrainOptions, ck: &Checkpoint, threads: usize) {
+    if let Some(t) = ck.threads.filter(|&t| t != threads) {
+        eprintln!(
+            "note: {} ran on {t} threads and continues on {threads}; the result will not be bitwise the uninterrupted run's \
+             (give --threads {t} to keep it so)",
+            opts.out.display()
+        );
+    }
+}
+
 /// One run of a protocol (`hgym compare`, `hgym transfer`) in `opts.out`, with a progress bar:
 /// resumed from its checkpoint when one is there (then without `opts.init`: the checkpoint holds
 /// the networks), else started. Ctrl-C keeps the checkpoint and exits 130; the same command
@@ -782,7 +805,9 @@ pub fn finished_run(opts: &TrainOptions) -> Result<Option<EvalReport>> {
 pub fn protocol_run(pool: &rayon::ThreadPool, mut opts: TrainOptions, label: &str) -> Result<()> {
     let resume = if opts.out.join(hgym::train::checkpoint::FILE).exists() {
         opts.init = None;
-        Some(hgym::train::checkpoint::load(&opts.out)?)
+        let ck = hgym::train::checkpoint::load(&opts.out)?;
+        note_threads(&opts, &ck, pool.current_num_threads());
+        Some(ck)
     } else {
         None
     };

@@ -76,7 +76,9 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
         if p.init_critics && !dir.join(hgym::train::checkpoint::FILE).exists() {
             return Err(usage(format!(
                 "{}: the fine-tuning arm starts from the source's critics, and {} has no checkpoint (run folders commit \
-                 their policy, not their 50 MB checkpoint); make the source runs here with:\n  {}",
+                 their policy, not their 50 MB checkpoint); move the source run folders away and make them again here, \
+                 checkpoints included (on the CPU and thread count their manifests record they come out bitwise the \
+                 same, elsewhere as other runs of the same set-up):\n  {}",
                 p.name,
                 dir.display(),
                 p.source_command(&config_file)

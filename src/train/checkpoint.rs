@@ -10,9 +10,10 @@ use serde::{Deserialize, Serialize};
 use super::curve::CurveRow;
 use crate::flow::Level;
 
-/// 3: TD3/DDPG learners with `gradient_steps`, `action_l2` and the warm start of a fine-tuned
-/// actor; 2: the algorithm by name and its learner's own bytes (1 held an enum over the learners).
-pub const FORMAT: u32 = 3;
+/// 4: the worker thread count; 3: TD3/DDPG learners with `gradient_steps`, `action_l2` and the
+/// warm start of a fine-tuned actor; 2: the algorithm by name and its learner's own bytes (1 held
+/// an enum over the learners). Format 3 is still read (its thread count unknown).
+pub const FORMAT: u32 = 4;
 pub const FILE: &str = "checkpoint.bin";
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -34,6 +35,44 @@ pub struct Checkpoint {
     pub wall_s: f64,
     /// How many times the run was resumed.
     pub resumed: u32,
+    /// Worker threads of the session that wrote it (`None` from format 3): a run is bitwise
+    /// repeatable for the same seed and thread count, so a resume keeps this count.
+    pub threads: Option<usize>,
+}
+
+/// Format 3, the same fields without `threads`.
+#[derive(Deserialize)]
+struct CheckpointV3 {
+    format: u32,
+    env_id: String,
+    algo: String,
+    seed: u64,
+    level: Level,
+    config_toml: String,
+    learner: Vec<u8>,
+    curve: Vec<CurveRow>,
+    reference: Vec<f64>,
+    wall_s: f64,
+    resumed: u32,
+}
+
+impl From<CheckpointV3> for Checkpoint {
+    fn from(c: CheckpointV3) -> Self {
+        Checkpoint {
+            format: c.format,
+            env_id: c.env_id,
+            algo: c.algo,
+            seed: c.seed,
+            level: c.level,
+            config_toml: c.config_toml,
+            learner: c.learner,
+            curve: c.curve,
+            reference: c.reference,
+            wall_s: c.wall_s,
+            resumed: c.resumed,
+            threads: None,
+        }
+    }
 }
 
 /// Why a checkpoint could not be written or read back.
@@ -59,7 +98,7 @@ pub enum CheckpointError {
     },
     #[error("cannot encode the checkpoint")]
     Encode(#[source] bincode::Error),
-    #[error("{} has checkpoint format {found}, this hgym reads {FORMAT}", path.display())]
+    #[error("{} has checkpoint format {found}, this hgym reads formats 3 to {FORMAT}", path.display())]
     Format { path: PathBuf, found: u32 },
 }
 
@@ -92,12 +131,68 @@ pub fn load(dir: &Path) -> Result<Checkpoint, CheckpointError> {
         Ok(b) => b,
         Err(source) => return Err(CheckpointError::Read { path, source }),
     };
-    let ck: Checkpoint = match bincode::deserialize(&bytes) {
-        Ok(ck) => ck,
-        Err(source) => return Err(CheckpointError::Decode { path, source }),
+    // Every format starts with its number.
+    let decoded = match bincode::deserialize::<u32>(&bytes) {
+        Ok(FORMAT) => bincode::deserialize::<Checkpoint>(&bytes),
+        Ok(3) => bincode::deserialize::<CheckpointV3>(&bytes).map(Checkpoint::from),
+        Ok(found) => return Err(CheckpointError::Format { path, found }),
+        Err(source) => Err(source),
     };
-    if ck.format != FORMAT {
-        return Err(CheckpointError::Format { path, found: ck.format });
+    decoded.map_err(|source| CheckpointError::Decode { path, source })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(threads: Option<usize>) -> Checkpoint {
+        Checkpoint {
+            format: FORMAT,
+            env_id: "Cylinder_2D_Re100".into(),
+            algo: "td3".into(),
+            seed: 7,
+            level: Level::Coarse,
+            config_toml: "[train]\nsteps = 10\n".into(),
+            learner: vec![1, 2, 3],
+            curve: vec![],
+            reference: vec![1.5],
+            wall_s: 2.5,
+            resumed: 1,
+            threads,
+        }
     }
-    Ok(ck)
+
+    #[test]
+    fn round_trip_keeps_the_thread_count() {
+        let dir = tempfile::tempdir().unwrap();
+        save(dir.path(), &sample(Some(2))).unwrap();
+        let ck = load(dir.path()).unwrap();
+        assert_eq!(ck.threads, Some(2));
+        assert_eq!((ck.seed, ck.learner, ck.resumed), (7, vec![1, 2, 3], 1));
+    }
+
+    #[test]
+    fn format_3_reads_with_the_thread_count_unknown() {
+        let dir = tempfile::tempdir().unwrap();
+        // bincode writes the fields in order: format 3 is format 4 without the trailing
+        // `threads` (`None`, one byte) and with another number in front.
+        let mut bytes = bincode::serialize(&sample(None)).unwrap();
+        assert_eq!(bytes.pop(), Some(0));
+        bytes[..4].copy_from_slice(&3u32.to_le_bytes());
+        std::fs::write(dir.path().join(FILE), bytes).unwrap();
+        let ck = load(dir.path()).unwrap();
+        assert_eq!((ck.format, ck.threads, ck.seed, ck.wall_s), (3, None, 7, 2.5));
+    }
+
+    #[test]
+    fn an_older_format_is_refused_by_number() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut c = sample(Some(1));
+        c.format = 2;
+        save(dir.path(), &c).unwrap();
+        match load(dir.path()) {
+            Err(e @ CheckpointError::Format { found: 2, .. }) => assert!(e.to_string().contains("formats 3 to 4"), "{e}"),
+            other => panic!("expected a format error, got {other:?}"),
+        }
+    }
 }

@@ -286,6 +286,7 @@ pub fn train(
                 reference: reference.clone(),
                 wall_s,
                 resumed,
+                threads: Some(rayon::current_num_threads()),
             },
         )?;
         // The curve so far, to follow a long run from another terminal.
