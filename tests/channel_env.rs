@@ -52,6 +52,12 @@ fn actuation_is_zero_net_mass_flux_per_wall_and_bounded_by_u_tau() {
         );
     }
     assert!(s.max_divergence() < 1e-12);
+    // A uniform action (the sine baseline's) is no actuation, not a round-off net flux.
+    let r = env.step(&vec![0.3; n]).unwrap();
+    assert!(r.obs.iter().all(|v| v.is_finite()));
+    let s = env.solver();
+    let g = s.grid();
+    assert!((0..g.nz).all(|k| (0..g.nx).all(|i| s.v()[g.at_v(i, 0, k)] == 0.0)));
 }
 
 #[test]

@@ -92,6 +92,10 @@ fn leaderboard_rebuilds_the_committed_one_from_the_committed_results() {
     );
     assert!(md.contains(&format!("The uncontrolled flow at this level: {text}.")));
     assert!(entries.iter().filter(|e| e["stale"] == true).all(|e| e.get("literature").is_none()));
+    // Every current entry says something, if only that hgym bundles no reference for its flow.
+    for e in entries.iter().filter(|e| e["stale"] == false) {
+        assert!(e["literature"].as_str().is_some_and(|t| !t.is_empty()), "{}", e["env_id"]);
+    }
     // Every entry says how to make it again; a training run's command takes the run's own
     // configuration from its folder (`--config RUN_DIR`), and each entry links its folders.
     let td3 = "hgym train --env Cylinder_2D_Re100 --algo td3 --res coarse --seeds 0..=4 \

@@ -20,4 +20,5 @@ pub mod channel;
 pub mod comm;
 pub mod geometry;
 pub mod lbm;
+pub mod panel;
 pub mod spectral;

@@ -54,20 +54,12 @@ fn current_hash(id: &str, config_toml: Option<&str>) -> Option<String> {
     run_spec(id, config_toml).map(|s| s.hash())
 }
 
-/// The committed deviation from the literature of the uncontrolled flow of `id` at `level` with
-/// a run's training configuration (`hgym validate --env ID --level L --record`).
+/// How far the uncontrolled flow of `id` at `level`, with a run's training configuration, is
+/// from the literature (`hgym::fidelity::sentence`).
 fn literature(id: &str, level: &str, config_toml: Option<&str>) -> Option<String> {
-    use hgym::fidelity::Known;
     let spec = run_spec(id, config_toml)?;
     let level: hgym::flow::Level = level.parse().ok()?;
-    match hgym::fidelity::known(&spec, level) {
-        Known::Measured(e) => Some(e.describe()),
-        Known::NotMeasured => Some(format!(
-            "not measured against the literature (`hgym validate --env {id} --level {}` measures it)",
-            level.name()
-        )),
-        Known::NoReference => None,
-    }
+    Some(hgym::fidelity::sentence(&spec, level))
 }
 
 /// `hgym leaderboard`: writes results/leaderboard.json, LEADERBOARD.md and the bar charts.

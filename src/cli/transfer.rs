@@ -149,17 +149,26 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
         println!("{}", serde_json::to_string_pretty(&cmp)?);
         return Ok(Outcome::Ok);
     }
+    let threshold = match cmp.threshold.is_finite() {
+        true => format!(
+            "threshold {:.2} ({:.0} % of scratch's gain over the uncontrolled {:.2})",
+            cmp.threshold,
+            100.0 * p.fraction,
+            cmp.uncontrolled_return
+        ),
+        false => format!(
+            "no threshold: training from scratch ends at {:.2}, not above the uncontrolled {:.2}",
+            cmp.scratch_final_return, cmp.uncontrolled_return
+        ),
+    };
     println!(
-        "{}: {} -> {} ({}, {}), seeds {:?}; threshold {:.2} ({:.0} % of scratch's gain over the uncontrolled {:.2})",
+        "{}: {} -> {} ({}, {}), seeds {:?}; {threshold}",
         p.name,
         p.source,
         p.target,
         p.algo,
         p.level.name(),
         p.seeds,
-        cmp.threshold,
-        100.0 * p.fraction,
-        cmp.uncontrolled_return
     );
     for a in &cmp.arms {
         println!(
@@ -180,8 +189,10 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
             "  fine-tuning saves {:.0} % of the episodes and {:.0} % of the core-hours to the threshold",
             cmp.episode_saving_pct, cmp.cost_saving_pct
         );
-    } else {
+    } else if cmp.threshold.is_finite() {
         println!("  no saving to report: the fine-tuning or the from-scratch arm never stays above the threshold");
+    } else {
+        println!("  no saving to report: there is no gain over the uncontrolled flow to reach a fraction of");
     }
     println!("  results: {}", root.display());
     Ok(Outcome::Ok)

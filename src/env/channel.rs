@@ -692,11 +692,15 @@ impl Env for ChannelEnv {
         for wall in 0..self.spec.walls() {
             let acts = &a[wall * per_wall..(wall + 1) * per_wall];
             let mean = acts.iter().sum::<f64>() / per_wall as f64;
+            // A uniform action leaves only the round-off of the mean: no actuation (the solver
+            // would otherwise see a net flux of the size of the values themselves).
+            let spread = acts.iter().fold(0.0f64, |m, x| m.max((x - mean).abs()));
+            let uniform = spread <= 8.0 * f64::EPSILON * mean.abs();
             let out = &mut self.plane[wall];
             for k in 0..nz {
                 for i in 0..nx {
                     let q = (k / bz) * px + i / bx;
-                    let blowing = (acts[q] - mean) * self.u_tau;
+                    let blowing = if uniform { 0.0 } else { (acts[q] - mean) * self.u_tau };
                     rms += blowing * blowing;
                     // v on the top wall points out of the fluid.
                     out[k * nx + i] = if wall == 0 { blowing } else { -blowing };

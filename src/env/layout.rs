@@ -4,8 +4,9 @@
 //!
 //! Lattice-Boltzmann environments observe `(u, v, p[, T])` at each probe, positioned relative to
 //! the centre of their first body in its reference length (D); actuators are named from their
-//! kind and, for independent jets, from where they sit on the body (`jet_front_top`, ...). Other
-//! families are known by index (`obs0`, `a0`, ...).
+//! kind and, for independent jets, from where they sit on the body (`jet_front_top`, ...). The 3D
+//! ones with a section actuator on each spanwise segment add `w` and, with several segments, the
+//! segment ([`Layout::of3`]). Other families are known by index (`obs0`, `a0`, ...).
 
 use std::fmt;
 
@@ -65,6 +66,45 @@ impl Layout {
             observations,
             actuators: actuator_names(&spec.actuation, center),
         }
+    }
+
+    /// The layout of a 3D lattice-Boltzmann environment whose section actuator repeats on each
+    /// spanwise segment: `(u, v, w, p[, T])` at each probe of each segment's mid-plane, relative
+    /// to the first body's centre in its reference length, and the section's actuators. With one
+    /// segment the names are the 2D ones (a 2D policy reads the same probes and drives the same
+    /// actuator); with several, each quantity and actuator carries its segment (`u@s2`,
+    /// `jet_pair@s2`), so a whole-flow map never silently reads one segment for another. Surface
+    /// jets (sphere, cube) are known by index.
+    pub fn of3(spec: &super::spec3::Env3Spec) -> Self {
+        let super::spec3::Actuation3Spec::Segments { actuator } = &spec.actuation else {
+            return Layout::indexed(spec.obs_dim(), spec.act_dim());
+        };
+        let (center, d) = spec
+            .bodies
+            .first()
+            .map_or(([0.0, 0.0], 1.0), |b| (b.center(), b.reference_length()));
+        let mut quantities = vec!["u", "v", "w", "p"];
+        if spec.thermal.is_some() {
+            quantities.push("T");
+        }
+        let segments = spec.segments();
+        let name = |base: &str, s: usize| match segments {
+            1 => base.to_string(),
+            _ => format!("{base}@s{s}"),
+        };
+        let mut observations = vec![];
+        for s in 0..segments {
+            for p in &spec.probes {
+                let at = [(p[0] - center[0]) / d, (p[1] - center[1]) / d];
+                observations.extend(quantities.iter().map(|q| Channel {
+                    quantity: name(q, s),
+                    at: Some(at),
+                }));
+            }
+        }
+        let section = actuator_names(actuator, center);
+        let actuators = (0..segments).flat_map(|s| section.iter().map(move |a| name(a, s))).collect();
+        Layout { observations, actuators }
     }
 }
 
@@ -166,6 +206,20 @@ mod tests {
         assert_eq!(layout("RotaryCylinder_2D_Re100").actuators, ["rotation"]);
         assert_eq!(layout("Pinball_2D_Re100").actuators, ["rotation0", "rotation1", "rotation2"]);
         assert_eq!(layout("Kolmogorov_2D_Re40").actuators, ["a0", "a1", "a2", "a3"]);
+        // The 3D cylinder of one segment reads the 2D rake (plus w) and drives the same pair.
+        let c3 = layout("Cylinder_3D_Re200");
+        assert_eq!(c3.observations.len(), 80);
+        assert_eq!(
+            c3.observations[3],
+            Channel {
+                quantity: "p".into(),
+                at: Some([1.0, -1.0])
+            }
+        );
+        assert_eq!(c3.actuators, ["jet_pair"]);
+        let c4 = layout("Cylinder_3D_Re1000");
+        assert_eq!(c4.actuators, ["jet_pair@s0", "jet_pair@s1", "jet_pair@s2", "jet_pair@s3"]);
+        assert_eq!(c4.observations[80].quantity, "u@s1");
         assert_eq!(
             s.to_string(),
             "20 probes of (u, v, p) at x/D 1..5, y/D -1..1 from the body; actuators jet_front_top, jet_front_bottom, jet_rear_top, jet_rear_bottom"

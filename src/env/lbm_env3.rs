@@ -709,6 +709,10 @@ impl FamilySpec for Env3Spec {
         Env3Spec::act_dim(self)
     }
 
+    fn layout(&self) -> super::layout::Layout {
+        super::layout::Layout::of3(self)
+    }
+
     fn control_interval(&self) -> f64 {
         self.control_interval
     }

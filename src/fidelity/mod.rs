@@ -11,6 +11,9 @@
 //! This module joins `env` and `validate`, which know nothing of each other.
 
 pub mod kolmogorov;
+mod sentence;
+
+pub use sentence::sentence;
 
 use std::collections::BTreeMap;
 use std::path::Path;

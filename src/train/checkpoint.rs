@@ -36,43 +36,9 @@ pub struct Checkpoint {
     /// How many times the run was resumed.
     pub resumed: u32,
     /// Worker threads of the session that wrote it (`None` from format 3): a run is bitwise
-    /// repeatable for the same seed and thread count, so a resume keeps this count.
+    /// repeatable for the same seed and thread count, so a resume keeps this count. Stays the
+    /// last field (`load` reads format 3 by appending it).
     pub threads: Option<usize>,
-}
-
-/// Format 3, the same fields without `threads`.
-#[derive(Deserialize)]
-struct CheckpointV3 {
-    format: u32,
-    env_id: String,
-    algo: String,
-    seed: u64,
-    level: Level,
-    config_toml: String,
-    learner: Vec<u8>,
-    curve: Vec<CurveRow>,
-    reference: Vec<f64>,
-    wall_s: f64,
-    resumed: u32,
-}
-
-impl From<CheckpointV3> for Checkpoint {
-    fn from(c: CheckpointV3) -> Self {
-        Checkpoint {
-            format: c.format,
-            env_id: c.env_id,
-            algo: c.algo,
-            seed: c.seed,
-            level: c.level,
-            config_toml: c.config_toml,
-            learner: c.learner,
-            curve: c.curve,
-            reference: c.reference,
-            wall_s: c.wall_s,
-            resumed: c.resumed,
-            threads: None,
-        }
-    }
 }
 
 /// Why a checkpoint could not be written or read back.
@@ -131,10 +97,11 @@ pub fn load(dir: &Path) -> Result<Checkpoint, CheckpointError> {
         Ok(b) => b,
         Err(source) => return Err(CheckpointError::Read { path, source }),
     };
-    // Every format starts with its number.
+    // Every format starts with its number. bincode writes the fields in order, so format 3 is
+    // format 4 without the trailing `threads`: one byte 0 (`None`) appended makes it one.
     let decoded = match bincode::deserialize::<u32>(&bytes) {
         Ok(FORMAT) => bincode::deserialize::<Checkpoint>(&bytes),
-        Ok(3) => bincode::deserialize::<CheckpointV3>(&bytes).map(Checkpoint::from),
+        Ok(3) => bincode::deserialize::<Checkpoint>(&[bytes.as_slice(), &[0]].concat()),
         Ok(found) => return Err(CheckpointError::Format { path, found }),
         Err(source) => Err(source),
     };

@@ -6,7 +6,9 @@
 //! seeds). A run reaches it at the first evaluation from which it stays at or above it (every
 //! later evaluation too): a fine-tuning run evaluates its starting policy at 0 samples, and a
 //! source that is good enough there but is unlearned in the first updates must not count as
-//! having reached it at 0. A run whose final evaluation is below never reaches it.
+//! having reached it at 0. A run whose final evaluation is below never reaches it. When the
+//! from-scratch arm ends at or below the uncontrolled return there is no gain to reach a fraction
+//! of: the threshold is undefined (`null`), no arm reaches it, and no saving is reported.
 //! Final drag reductions and returns are each run's final evaluation (`metrics.json`). Cost is
 //! core-hours: wall time times threads; the cost to threshold scales a run's core-hours by the
 //! fraction of its samples spent before reaching the threshold.
@@ -68,6 +70,9 @@ pub struct TransferComparison {
 
 /// Samples at the first evaluation from which every evaluation is at or above `threshold`.
 fn stays_above(rows: &[CurveRow], threshold: f64) -> Option<u64> {
+    if !threshold.is_finite() {
+        return None;
+    }
     let evals: Vec<&CurveRow> = rows.iter().filter(|r| r.eval_return.is_finite()).collect();
     let from = evals.iter().rposition(|r| r.eval_return < threshold).map_or(0, |k| k + 1);
     evals.get(from).map(|r| r.samples)
@@ -126,10 +131,13 @@ pub fn analyse(p: &Protocol, root: &Path, r0: f64, episode_actions: usize) -> Re
     }
     let scratch: Vec<f64> = curves.iter().filter(|c| c.0 == "scratch").map(|c| final_eval(&c.1)).collect();
     let r_scratch = Stat::of(&scratch).mean;
-    let threshold = r0 + p.fraction * (r_scratch - r0);
+    let threshold = match r_scratch > r0 {
+        true => r0 + p.fraction * (r_scratch - r0),
+        false => f64::NAN,
+    };
     for (run, (_, rows)) in runs.iter_mut().zip(&curves) {
         run.samples_to_threshold = if run.arm == "zeroshot" {
-            (run.final_return >= threshold).then_some(0)
+            (threshold.is_finite() && run.final_return >= threshold).then_some(0)
         } else {
             stays_above(rows, threshold)
         };
@@ -198,12 +206,17 @@ fn plot(p: &Protocol, cmp: &TransferComparison, curves: &[(String, Vec<CurveRow>
         .iter()
         .find(|a| a.arm == "zeroshot")
         .map_or(f64::NAN, |a| a.final_return.mean);
-    let hlines = [
+    let hlines: Vec<(String, f64)> = [
         ("zero-shot (source policy, mean)".to_string(), zs),
         (format!("threshold ({:.0} % of scratch's gain)", 100.0 * p.fraction), cmp.threshold),
         ("uncontrolled".to_string(), cmp.uncontrolled_return),
-    ];
-    let saving = if cmp.episode_saving_pct.is_finite() {
+    ]
+    .into_iter()
+    .filter(|(_, y)| y.is_finite())
+    .collect();
+    let saving = if !cmp.threshold.is_finite() {
+        "no threshold: training from scratch does not beat the uncontrolled flow".to_string()
+    } else if cmp.episode_saving_pct.is_finite() {
         format!("fine-tuning saves {:.0} % of episodes", cmp.episode_saving_pct)
     } else {
         "no saving: an arm never stays above the threshold".to_string()
@@ -236,5 +249,7 @@ mod tests {
         assert_eq!(stays_above(&rows(&[-400.0, -410.0]), -440.0), Some(0));
         // Ends below: never.
         assert_eq!(stays_above(&rows(&[-400.0, -430.0, -450.0]), -440.0), None);
+        // No threshold (scratch never beat the uncontrolled flow): never.
+        assert_eq!(stays_above(&rows(&[-400.0, -410.0]), f64::NAN), None);
     }
 }

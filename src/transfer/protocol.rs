@@ -26,6 +26,10 @@ pub const BUNDLED: &[(&str, &str)] = &[
         "cylinder_square_re200",
         include_str!("../../benchmarks/protocols/transfer/cylinder_square_re200.toml"),
     ),
+    (
+        "cylinder_2d_3d_re200",
+        include_str!("../../benchmarks/protocols/transfer/cylinder_2d_3d_re200.toml"),
+    ),
 ];
 
 /// The three arms, in the order they run.
@@ -191,7 +195,14 @@ mod tests {
             for id in [&p.source, &p.target] {
                 crate::env::lookup(id).unwrap_or_else(|e| panic!("{}: {e}", p.name));
             }
-            assert!(p.seeds.len() >= 5, "{}: the 2D protocols run >= 5 seeds", p.name);
+            let target = crate::env::lookup(&p.target).unwrap();
+            let seeds = if target.dimension() == 2 { 5 } else { 3 };
+            assert!(
+                p.seeds.len() >= seeds,
+                "{}: a protocol to a {}D flow runs >= {seeds} seeds",
+                p.name,
+                target.dimension()
+            );
             let spec = crate::train::resolve_spec(&p.source, &p.config).unwrap();
             assert_eq!(spec.hash(), p.source_spec_hash, "{}: pinned source hash", p.name);
         }
