@@ -34,6 +34,10 @@ fn no_reference(id: &str) -> String {
     format!("hgym bundles no literature reference for the uncontrolled flow of {id}")
 }
 
+fn not_calibrated(id: &str) -> String {
+    format!("its uncontrolled statistics are not calibrated (`hgym envs calibrate {id}` measures them)")
+}
+
 fn pct(measured: f64, reference: f64) -> String {
     format!("{:+.1} %", 100.0 * (measured / reference - 1.0))
 }
@@ -44,10 +48,7 @@ fn pct(measured: f64, reference: f64) -> String {
 fn channel(s: &ChannelSpec) -> String {
     let st = &s.statistics;
     if st.tau_w <= 0.0 {
-        return format!(
-            "its uncontrolled statistics are not calibrated (`hgym envs calibrate {}` measures them)",
-            s.id
-        );
+        return not_calibrated(&s.id);
     }
     let re_tau = st.tau_w.sqrt() * s.reynolds_bulk;
     let c_f = 2.0 * st.tau_w;
@@ -76,10 +77,7 @@ fn kolmogorov(s: &KolmogorovSpec) -> String {
     };
     let st = &s.statistics;
     if st.dissipation_mean <= 0.0 {
-        return format!(
-            "its uncontrolled statistics are not calibrated (`hgym envs calibrate {}` measures them)",
-            s.id
-        );
+        return not_calibrated(&s.id);
     }
     let d_lam = s.reynolds / (2.0 * (s.kf as f64).powi(2));
     let ratio = st.dissipation_mean / d_lam;
