@@ -369,6 +369,7 @@ mod tests {
     /// `1 - omega` and the trace by `1 - OMEGA_BULK`, `g_i* = g_i^eq + w_i / (2 c_s^4) Q_i : Pi`.
     /// On a state far from equilibrium (a 0.3 instead of 0.25 in one coefficient errs by 1e-5).
     #[test]
+    #[allow(clippy::needless_range_loop)] // the sums over directions read like the formulas
     fn the_pair_form_is_the_textbook_regularised_collision() {
         let mut far = equilibrium(0.01, 0.05, -0.03);
         let noise = [0.02, -0.04, 0.03, 0.014, -0.022, 0.006, -0.008, 0.018, -0.004];
