@@ -16,6 +16,7 @@
 //!
 //! Errors are typed ([`lbm::LbmError`]); nothing here panics on user input.
 
+pub mod blasius;
 pub mod channel;
 pub mod comm;
 pub mod geometry;

@@ -49,13 +49,11 @@ fn influence(a: [f64; 2], b: [f64; 2], p: [f64; 2], on_panel: bool) -> [[f64; 2]
     let (dx, dy) = (p[0] - a[0], p[1] - a[1]);
     let x = dx * tx + dy * ty;
     let y = -dx * ty + dy * tx;
-    let (dtheta, log) = if on_panel {
-        (std::f64::consts::PI, ((x * x) / ((x - l) * (x - l))).sqrt().ln())
+    let log = ((x * x + y * y) / ((x - l) * (x - l) + y * y)).sqrt().ln();
+    let dtheta = if on_panel {
+        std::f64::consts::PI
     } else {
-        (
-            y.atan2(x - l) - y.atan2(x),
-            ((x * x + y * y) / ((x - l) * (x - l) + y * y)).sqrt().ln(),
-        )
+        y.atan2(x - l) - y.atan2(x)
     };
     let two_pi = 2.0 * std::f64::consts::PI;
     // Density gamma_a (1 - s/l) + gamma_b s/l: the parts multiplying gamma_a and gamma_b.

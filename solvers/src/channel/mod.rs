@@ -6,6 +6,7 @@
 //! - [`grid`]: the staggered grid and its wall closures;
 //! - [`operators`]: advection, diffusion, divergence and gradient, plane by plane;
 //! - [`poisson`]: the direct pressure solver;
+//! - [`fringe`]: the fringe forcing that turns the periodic box into a spatially developing flow;
 //! - [`solver`]: [`Channel`], time stepping, drive, transpiration and diagnostics;
 //! - [`stats`]: plane-averaged means and second moments.
 
@@ -13,6 +14,7 @@
 #![allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 
 pub mod error;
+pub mod fringe;
 pub mod grid;
 pub mod operators;
 pub mod poisson;
@@ -20,6 +22,7 @@ pub mod solver;
 pub mod stats;
 
 pub use error::ChannelError;
+pub use fringe::{BaseFlow, Fringe, FringeSpec};
 pub use grid::{Grid, Top};
 pub use solver::{viscous_dt_limit, Channel, ChannelConfig, ChannelState, Drive};
 pub use stats::{PlaneSums, Profiles};

@@ -8,7 +8,8 @@
 //! At a no-slip wall `u = w = 0` and `v` is the prescribed transpiration; the wall-normal
 //! derivative of `u` and `w` there is that of the quadratic through the wall value and the first
 //! two centres, so a quadratic profile (laminar Poiseuille flow) is reproduced exactly. At a
-//! free-slip top `v = 0` and the derivatives of `u` and `w` vanish.
+//! free-slip top `v` is prescribed (zero unless a boundary layer's outflow is set) and the
+//! derivatives of `u` and `w` vanish.
 
 use super::grid::Grid;
 

@@ -9,12 +9,14 @@
 //! step of `du/dt = P R(u)` on divergence-free fields: third order in time, divergence-free to
 //! round-off. Everything is explicit (the viscous limit on `dt` is checked up front). The flow is
 //! driven by a constant pressure gradient or held at a constant bulk velocity by a uniform
-//! correction after each projection. Wall transpiration (`v` on the wall faces) is prescribed per
-//! wall cell and must carry no net volume flux.
+//! correction after each projection. Wall transpiration (`v` on the wall faces, or through a
+//! free-slip top) is prescribed per wall cell and must carry no net volume flux. A [`Fringe`] makes
+//! the periodic box compute a spatially developing flow.
 
 use rayon::prelude::*;
 
 use super::error::ChannelError;
+use super::fringe::{BaseFlow, Fringe, FringeSpec};
 use super::grid::{Grid, Top};
 use super::operators::{correct_uw_row, correct_v_row, divergence_row, rhs_uw_row, rhs_v_row, Fields};
 use super::poisson::Poisson;
@@ -54,10 +56,15 @@ pub struct ChannelConfig {
 /// Largest stable `dt` of RK3 for explicit diffusion: `|lambda dt| <= 2.51` on the real axis,
 /// with `lambda` bounded by `nu (4/dx^2 + 4/dz^2 + max_j 4/(dyf_j dyc_j))` and a margin of 10 %.
 pub fn viscous_dt_limit(g: &Grid, nu: f64) -> f64 {
+    damped_dt_limit(g, nu, 0.0)
+}
+
+/// The same limit with a linear damping of rate `damping` (a fringe) added to the diffusion.
+fn damped_dt_limit(g: &Grid, nu: f64, damping: f64) -> f64 {
     let ymax = (0..g.ny)
         .map(|j| 2.0 / g.dyf[j] * (1.0 / g.dyc[j] + 1.0 / g.dyc[j + 1]))
         .fold(0.0, f64::max);
-    let lam = nu * (4.0 / (g.dx * g.dx) + 4.0 / (g.dz * g.dz) + ymax);
+    let lam = nu * (4.0 / (g.dx * g.dx) + 4.0 / (g.dz * g.dz) + ymax) + damping;
     0.9 * 2.51 / lam
 }
 
@@ -82,6 +89,7 @@ pub struct Channel {
     r: [Vec<f64>; 3],
     r_prev: [Vec<f64>; 3],
     poisson: Poisson,
+    fringe: Option<Fringe>,
     /// Per-plane partial sums, reduced in plane order.
     partial: Vec<f64>,
     /// The mean pressure gradient of the last stage (the drive, or what holds the flow rate).
@@ -114,6 +122,7 @@ impl Channel {
         let bufs = || [vec![0.0; cells], vec![0.0; faces], vec![0.0; cells]];
         Ok(Channel {
             poisson: Poisson::new(&grid),
+            fringe: None,
             u: vec![0.0; cells],
             v: vec![0.0; faces],
             w: vec![0.0; cells],
@@ -229,7 +238,8 @@ impl Channel {
 
     /// Sets wall-normal velocity on the wall faces, `nx nz` values each in `at(i, 0, k)` order
     /// (i + k nx): `bottom` positive is blowing into the fluid, `top` positive is suction out of it
-    /// (both are `v`). The net flux must vanish; a free-slip top takes none.
+    /// (both are `v`). The net flux must vanish. Through a free-slip top it is the outflow that
+    /// sets the free stream of a boundary layer (its `u` keeps a zero normal derivative).
     pub fn set_transpiration(&mut self, bottom: &[f64], top: &[f64]) -> Result<(), ChannelError> {
         let g = &self.grid;
         let n = g.nx * g.nz;
@@ -237,9 +247,6 @@ impl Channel {
             if got != n {
                 return Err(ChannelError::Size { what, got, want: n });
             }
-        }
-        if g.top == Top::FreeSlip && top.iter().any(|&t| t != 0.0) {
-            return Err(ChannelError::config("transpiration", "a free-slip top takes no transpiration"));
         }
         let net = (bottom.iter().sum::<f64>() - top.iter().sum::<f64>()) / n as f64;
         let scale = bottom.iter().chain(top).fold(0.0f64, |m, &x| m.max(x.abs()));
@@ -317,6 +324,28 @@ impl Channel {
         self.hold_flow_rate();
     }
 
+    /// Adds a fringe region pulling towards `base`; the time step must also be stable for its
+    /// damping. The top's outflow is the caller's to set (`base.top()` for a free-slip top).
+    pub fn set_fringe(&mut self, spec: FringeSpec, base: BaseFlow) -> Result<(), ChannelError> {
+        let fringe = Fringe::new(&self.grid, spec, base)?;
+        let limit = damped_dt_limit(&self.grid, self.cfg.nu, spec.lambda_max);
+        if self.cfg.dt > limit {
+            return Err(ChannelError::config(
+                "fringe",
+                format!(
+                    "lambda_max = {} needs dt <= {limit:.4e} (dt is {}); lower one of them",
+                    spec.lambda_max, self.cfg.dt
+                ),
+            ));
+        }
+        self.fringe = Some(fringe);
+        Ok(())
+    }
+
+    pub fn fringe(&self) -> Option<&Fringe> {
+        self.fringe.as_ref()
+    }
+
     /// One time step (three stages).
     pub fn step(&mut self) -> Result<(), ChannelError> {
         let dt = self.cfg.dt;
@@ -371,17 +400,32 @@ impl Channel {
             Drive::FlowRate(_) => 0.0,
         };
         let (nx, ny) = (g.nx, g.ny);
+        let fringe = self.fringe.as_ref();
         let [ru, rv, rw] = &mut self.r;
         ru.par_chunks_mut(nx)
             .zip(rw.par_chunks_mut(nx))
             .enumerate()
             .with_min_len(ROWS_PER_TASK)
-            .for_each(|(r, (ru, rw))| rhs_uw_row(g, &f, nu, drive, r % ny, r / ny, ru, rw));
+            .for_each(|(r, (ru, rw))| {
+                let (j, k) = (r % ny, r / ny);
+                rhs_uw_row(g, &f, nu, drive, j, k, ru, rw);
+                if let Some(fr) = fringe {
+                    let a = g.at(0, j, k);
+                    fr.force_uw_row(j, &f.u[a..a + nx], &f.w[a..a + nx], ru, rw);
+                }
+            });
         rv.par_chunks_mut(nx)
             .enumerate()
             .with_min_len(ROWS_PER_TASK)
             .filter(|(r, _)| r % (ny + 1) != 0 && r % (ny + 1) != ny)
-            .for_each(|(r, rv)| rhs_v_row(g, &f, nu, r % (ny + 1), r / (ny + 1), rv));
+            .for_each(|(r, rv)| {
+                let (j, k) = (r % (ny + 1), r / (ny + 1));
+                rhs_v_row(g, &f, nu, j, k, rv);
+                if let Some(fr) = fringe {
+                    let a = g.at_v(0, j, k);
+                    fr.force_v_row(j, &f.v[a..a + nx], rv);
+                }
+            });
     }
 
     /// `div grad phi = div u`, `u -= grad phi`; `alpha_dt` scales `phi` to a pressure.

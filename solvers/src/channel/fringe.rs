@@ -1,0 +1,233 @@
+//! The fringe region (Nordstrom, Nordin & Henningson, SIAM J. Sci. Comput. 20, 1999): a volume
+//! force `lambda(x) (u_target - u)` added to the momentum equations near the end of the periodic
+//! box pulls the outflow back to a prescribed inflow, so the periodic solver computes a spatially
+//! developing flow (a boundary layer growing in x) upstream of the fringe.
+//!
+//! `lambda(x) = lambda_max [S((x - x_start) / rise) - S((x - x_end) / fall + 1)]` with the smooth
+//! step `S(a) = 0` for `a <= 0`, `1 / (1 + exp(1/(a - 1) + 1/a))` for `0 < a < 1` and `1` for
+//! `a >= 1`. The target is a [`BaseFlow`] `(u(x, y), v(x, y), 0)`: a laminar or mean profile
+//! upstream of the fringe, blended inside it back to the inflow, with the `v` of discrete
+//! continuity, so the target is itself divergence-free and its `v` at the top is the outflow the
+//! top boundary must carry.
+
+use super::error::ChannelError;
+use super::grid::Grid;
+
+/// Where the fringe lies and how hard it pulls.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FringeSpec {
+    /// Start and end of the region in x (`0 <= x_start < x_end <= lx`).
+    pub x_start: f64,
+    pub x_end: f64,
+    /// Widths over which `lambda` rises from 0 and falls back (their sum at most `x_end - x_start`).
+    pub rise: f64,
+    pub fall: f64,
+    /// Peak strength (an inverse time).
+    pub lambda_max: f64,
+}
+
+/// The forcing ready to apply: `lambda` at the `u` and at the centre x-positions, and the target.
+#[derive(Clone, Debug)]
+pub struct Fringe {
+    spec: FringeSpec,
+    lambda_u: Vec<f64>,
+    lambda_c: Vec<f64>,
+    base: BaseFlow,
+}
+
+/// A spanwise-uniform, discretely divergence-free field on the grid: `u` at the x-faces (`ny` rows
+/// of `nx`) and `v` at the y-faces (`ny + 1` rows of `nx`, the walls included).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BaseFlow {
+    pub u: Vec<f64>,
+    pub v: Vec<f64>,
+    nx: usize,
+    ny: usize,
+}
+
+impl BaseFlow {
+    /// `u = profile(x, y)` upstream of the fringe; inside it `(1 - b) profile(x_start, y) +
+    /// b profile(0, y)` with `b = S((x - x_start) / (x_end - x_start))`, which returns to the
+    /// inflow at `x_end` (and `x_end` must then be `lx`, the inflow's periodic image). `v` follows
+    /// from continuity, cell by cell up from a solid bottom wall.
+    pub fn blended(grid: &Grid, spec: &FringeSpec, profile: impl Fn(f64, f64) -> f64) -> Self {
+        let (nx, ny) = (grid.nx, grid.ny);
+        let mut u = vec![0.0; nx * ny];
+        for i in 0..nx {
+            let x = i as f64 * grid.dx;
+            let b = smooth_step((x - spec.x_start) / (spec.x_end - spec.x_start));
+            for j in 0..ny {
+                let y = grid.yc[j];
+                u[j * nx + i] = if x < spec.x_start {
+                    profile(x, y)
+                } else {
+                    (1.0 - b) * profile(spec.x_start, y) + b * profile(0.0, y)
+                };
+            }
+        }
+        let mut v = vec![0.0; nx * (ny + 1)];
+        for j in 0..ny {
+            for i in 0..nx {
+                let dudx = (u[j * nx + (i + 1) % nx] - u[j * nx + i]) / grid.dx;
+                v[(j + 1) * nx + i] = v[j * nx + i] - grid.dyf[j] * dudx;
+            }
+        }
+        BaseFlow { u, v, nx, ny }
+    }
+
+    /// `v` through the top, `nx` values: the outflow (positive) a boundary layer's displacement
+    /// pushes out and the inflow that returns it in the fringe; they sum to zero.
+    pub fn top(&self) -> &[f64] {
+        &self.v[self.ny * self.nx..]
+    }
+}
+
+/// The smooth step `S` of Nordstrom et al.
+pub fn smooth_step(a: f64) -> f64 {
+    if a <= 0.0 {
+        0.0
+    } else if a >= 1.0 {
+        1.0
+    } else {
+        1.0 / (1.0 + (1.0 / (a - 1.0) + 1.0 / a).exp())
+    }
+}
+
+impl FringeSpec {
+    /// `lambda(x)`.
+    pub fn lambda(&self, x: f64) -> f64 {
+        self.lambda_max * (smooth_step((x - self.x_start) / self.rise) - smooth_step((x - self.x_end) / self.fall + 1.0))
+    }
+}
+
+impl Fringe {
+    /// The fringe of `spec` on `grid`, pulling towards `base`.
+    pub fn new(grid: &Grid, spec: FringeSpec, base: BaseFlow) -> Result<Self, ChannelError> {
+        let fits = 0.0 <= spec.x_start && spec.x_start < spec.x_end && spec.x_end <= grid.lx;
+        if !fits {
+            return Err(ChannelError::config(
+                "fringe",
+                format!("[{}, {}] must be an interval inside [0, {}]", spec.x_start, spec.x_end, grid.lx),
+            ));
+        }
+        let ramps = spec.rise > 0.0 && spec.fall > 0.0 && spec.rise + spec.fall <= spec.x_end - spec.x_start;
+        if !ramps {
+            return Err(ChannelError::config(
+                "fringe",
+                format!(
+                    "rise {} and fall {} must be positive and fit in the fringe's {}",
+                    spec.rise,
+                    spec.fall,
+                    spec.x_end - spec.x_start
+                ),
+            ));
+        }
+        if !(spec.lambda_max > 0.0 && spec.lambda_max.is_finite()) {
+            return Err(ChannelError::config(
+                "fringe",
+                format!("lambda_max = {} must be positive", spec.lambda_max),
+            ));
+        }
+        if (base.nx, base.ny) != (grid.nx, grid.ny) {
+            let (got, want) = (base.u.len(), grid.nx * grid.ny);
+            return Err(ChannelError::Size {
+                what: "fringe base flow",
+                got,
+                want,
+            });
+        }
+        Ok(Fringe {
+            lambda_u: (0..grid.nx).map(|i| spec.lambda(i as f64 * grid.dx)).collect(),
+            lambda_c: (0..grid.nx).map(|i| spec.lambda((i as f64 + 0.5) * grid.dx)).collect(),
+            spec,
+            base,
+        })
+    }
+
+    pub fn spec(&self) -> &FringeSpec {
+        &self.spec
+    }
+
+    /// `lambda` at the `u` positions `x = i dx`.
+    pub fn lambda_u(&self) -> &[f64] {
+        &self.lambda_u
+    }
+
+    pub fn base(&self) -> &BaseFlow {
+        &self.base
+    }
+
+    /// Adds the forcing of `u` and `w` on cell row `j` to their right-hand sides.
+    pub fn force_uw_row(&self, j: usize, u: &[f64], w: &[f64], ru: &mut [f64], rw: &mut [f64]) {
+        let n = ru.len();
+        let target = &self.base.u[j * n..][..n];
+        for i in 0..n {
+            ru[i] += self.lambda_u[i] * (target[i] - u[i]);
+            rw[i] -= self.lambda_c[i] * w[i];
+        }
+    }
+
+    /// Adds the forcing of `v` on face row `j` to its right-hand side.
+    pub fn force_v_row(&self, j: usize, v: &[f64], rv: &mut [f64]) {
+        let n = rv.len();
+        let target = &self.base.v[j * n..][..n];
+        for i in 0..n {
+            rv[i] += self.lambda_c[i] * (target[i] - v[i]);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::channel::Top;
+
+    #[test]
+    fn lambda_rises_holds_and_falls_smoothly() {
+        let s = FringeSpec {
+            x_start: 6.0,
+            x_end: 10.0,
+            rise: 1.5,
+            fall: 1.0,
+            lambda_max: 2.0,
+        };
+        assert_eq!(s.lambda(5.9), 0.0);
+        assert!((s.lambda(6.75) - 1.0).abs() < 1e-12, "half-way up the rise");
+        assert_eq!(s.lambda(8.0), 2.0);
+        assert!((s.lambda(9.5) - 1.0).abs() < 1e-12, "half-way down the fall");
+        assert_eq!(s.lambda(10.0), 0.0);
+        let g = Grid::new([20, 8, 1], [10.0, 1.0, 1.0], 0.0, Top::FreeSlip).unwrap();
+        let base = BaseFlow::blended(&g, &s, |_, _| 1.0);
+        let bad = Fringe::new(&g, FringeSpec { rise: 3.0, fall: 2.0, ..s }, base.clone());
+        assert!(matches!(bad, Err(ChannelError::Config { field: "fringe", .. })));
+        let other = Grid::new([20, 9, 1], [10.0, 1.0, 1.0], 0.0, Top::FreeSlip).unwrap();
+        let short = Fringe::new(&other, s, base);
+        assert!(matches!(short, Err(ChannelError::Size { .. })));
+    }
+
+    #[test]
+    fn the_base_flow_is_divergence_free_and_its_top_flux_sums_to_zero() {
+        let g = Grid::new([40, 16, 1], [20.0, 6.0, 1.0], 1.5, Top::FreeSlip).unwrap();
+        let s = FringeSpec {
+            x_start: 14.0,
+            x_end: 20.0,
+            rise: 2.0,
+            fall: 1.0,
+            lambda_max: 1.0,
+        };
+        // A layer thickening like sqrt(x) over a free stream that speeds up.
+        let profile = |x: f64, y: f64| (1.0 + 0.01 * x) * (y / (1.0 + 0.1 * x).sqrt()).tanh();
+        let b = BaseFlow::blended(&g, &s, profile);
+        for j in 0..g.ny {
+            for i in 0..g.nx {
+                let div =
+                    (b.u[j * g.nx + (i + 1) % g.nx] - b.u[j * g.nx + i]) / g.dx + (b.v[(j + 1) * g.nx + i] - b.v[j * g.nx + i]) / g.dyf[j];
+                assert!(div.abs() < 1e-13, "{div}");
+            }
+        }
+        let net: f64 = b.top().iter().sum();
+        let out: f64 = b.top().iter().filter(|&&v| v > 0.0).sum();
+        assert!(out > 0.0 && net.abs() < 1e-13 * out, "{net} of {out}");
+        assert_eq!(b.u[3], profile(3.0 * g.dx, g.yc[0]));
+    }
+}
