@@ -16,6 +16,7 @@
 //!
 //! Errors are typed ([`lbm::LbmError`]); nothing here panics on user input.
 
+pub mod bl_integral;
 pub mod blasius;
 pub mod channel;
 pub mod comm;
@@ -23,3 +24,4 @@ pub mod geometry;
 pub mod lbm;
 pub mod panel;
 pub mod spectral;
+pub mod suction_side;

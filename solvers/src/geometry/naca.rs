@@ -68,6 +68,13 @@ impl Naca4 {
         }
     }
 
+    /// The closed outline in body coordinates (chord along x from the leading edge at the
+    /// origin), counter-clockwise from the trailing edge over the upper surface; 400 cosine-spaced
+    /// points per side.
+    pub fn outline(&self) -> &[[f64; 2]] {
+        &self.outline
+    }
+
     /// Half-thickness `y_t(x)` of a section of thickness `t` (fractions of the chord, closed
     /// trailing edge) and its slope `dy_t/dx`.
     pub fn half_thickness(t: f64, x: f64) -> (f64, f64) {
