@@ -1,10 +1,10 @@
 //! The spatially developing boundary layer of the channel solver: a fringe region recycles the
 //! periodic box into an inflow, the outflow through the free-slip top sets the free stream. The
 //! laminar case has an exact answer, the Blasius layer: its skin friction against its momentum
-//! thickness and its shape factor downstream of the inflow.
+//! thickness and its shape factor downstream of the inflow. A trip forces where it is placed.
 
 use hgym_solvers::blasius::Blasius;
-use hgym_solvers::channel::{BaseFlow, Channel, ChannelConfig, Drive, FringeSpec, Top};
+use hgym_solvers::channel::{BaseFlow, Channel, ChannelConfig, Drive, FringeSpec, Top, TripSpec};
 
 /// A Blasius layer entering at displacement thickness 1 (the length unit) with `Re_delta* = re`;
 /// `n` cells over the box `[lx, ly]`, the fringe over its last `fringe` lengths.
@@ -38,7 +38,7 @@ fn plate(n: [usize; 2], lx: f64, ly: f64, fringe: f64, re: f64, dt: f64) -> Plat
         fall: 0.3 * fringe,
         lambda_max: 1.0,
     };
-    let base = BaseFlow::blended(&g, &spec, |x, y| b.velocity(x0 + x, y, 1.0, nu).0);
+    let base = BaseFlow::blended(&g, &spec, |_| 1.0, |x, y| b.velocity(x0 + x, y, 1.0, nu).0);
     c.set_transpiration(&vec![0.0; g.nx], base.top()).unwrap();
     c.set_velocity(&base.u, &base.v, &vec![0.0; g.nx * g.ny]).unwrap();
     c.set_fringe(spec, base).unwrap();
@@ -99,4 +99,55 @@ fn a_laminar_plate_with_a_fringe_is_the_blasius_layer() {
         let ue = (0..g.ny).map(|j| p.c.u()[g.at(i, j, 0)]).fold(0.0, f64::max);
         assert!((ue - 1.0).abs() < 0.005, "edge velocity {ue} at x = {}", i as f64 * g.dx);
     }
+}
+
+/// A trip pushes the fluid up and down at its own place: one step from rest moves `v` most at
+/// `x0` near the wall, barely far downstream, and the same seed pushes the same way.
+#[test]
+fn a_trip_acts_where_it_is() {
+    let cfg = ChannelConfig {
+        n: [64, 32, 16],
+        length: [8.0, 2.0, 2.0],
+        stretch: 1.5,
+        top: Top::FreeSlip,
+        nu: 0.01,
+        dt: 0.01,
+        drive: Drive::PressureGradient(0.0),
+        check_interval: 0,
+    };
+    let trip = TripSpec {
+        x0: 2.0,
+        lx: 0.3,
+        ly: 0.2,
+        z_s: 0.5,
+        t_s: 1.0,
+        a_steady: 0.5,
+        a_time: 1.0,
+        seed: 3,
+    };
+    let run = || {
+        let mut c = Channel::new(cfg.clone()).unwrap();
+        c.set_trip(trip).unwrap();
+        c.step().unwrap();
+        c.v().to_vec()
+    };
+    let v = run();
+    let c = Channel::new(cfg.clone()).unwrap();
+    let g = c.grid();
+    let largest = |i0: usize, i1: usize| {
+        let mut m = 0.0f64;
+        for k in 0..g.nz {
+            for j in 1..g.ny {
+                for i in i0..i1 {
+                    m = m.max(v[g.at_v(i, j, k)].abs());
+                }
+            }
+        }
+        m
+    };
+    let near = largest(14, 18); // x in [1.75, 2.25)
+    let far = largest(40, 56); // x in [5, 7)
+    assert!(near > 1e-3, "{near}");
+    assert!(far < 0.05 * near, "{far} against {near}");
+    assert_eq!(v, run(), "the same seed pushes the same way");
 }

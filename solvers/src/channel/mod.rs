@@ -7,6 +7,7 @@
 //! - [`operators`]: advection, diffusion, divergence and gradient, plane by plane;
 //! - [`poisson`]: the direct pressure solver;
 //! - [`fringe`]: the fringe forcing that turns the periodic box into a spatially developing flow;
+//! - [`trip`]: the random volume force that trips a boundary layer;
 //! - [`solver`]: [`Channel`], time stepping, drive, transpiration and diagnostics;
 //! - [`stats`]: plane-averaged means and second moments.
 
@@ -16,13 +17,17 @@
 pub mod error;
 pub mod fringe;
 pub mod grid;
+pub mod layer;
 pub mod operators;
 pub mod poisson;
 pub mod solver;
 pub mod stats;
+pub mod trip;
 
 pub use error::ChannelError;
 pub use fringe::{BaseFlow, Fringe, FringeSpec};
 pub use grid::{Grid, Top};
+pub use layer::{LayerSums, Station};
 pub use solver::{viscous_dt_limit, Channel, ChannelConfig, ChannelState, Drive};
 pub use stats::{PlaneSums, Profiles};
+pub use trip::{Trip, TripSpec};

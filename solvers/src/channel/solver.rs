@@ -11,7 +11,7 @@
 //! driven by a constant pressure gradient or held at a constant bulk velocity by a uniform
 //! correction after each projection. Wall transpiration (`v` on the wall faces, or through a
 //! free-slip top) is prescribed per wall cell and must carry no net volume flux. A [`Fringe`] makes
-//! the periodic box compute a spatially developing flow.
+//! the periodic box compute a spatially developing flow, and a [`Trip`] makes its layer turbulent.
 
 use rayon::prelude::*;
 
@@ -20,9 +20,12 @@ use super::fringe::{BaseFlow, Fringe, FringeSpec};
 use super::grid::{Grid, Top};
 use super::operators::{correct_uw_row, correct_v_row, divergence_row, rhs_uw_row, rhs_v_row, Fields};
 use super::poisson::Poisson;
+use super::trip::{Trip, TripSpec};
 
 const GAMMA: [f64; 3] = [8.0 / 15.0, 5.0 / 12.0, 3.0 / 4.0];
 const ZETA: [f64; 3] = [0.0, -17.0 / 60.0, -5.0 / 12.0];
+/// Time of each stage within the step, in units of `dt`.
+const STAGE_TIME: [f64; 3] = [0.0, 8.0 / 15.0, 2.0 / 3.0];
 /// Grid rows per parallel task (a row is `nx` values); any value gives the same bits.
 const ROWS_PER_TASK: usize = 8;
 
@@ -90,6 +93,7 @@ pub struct Channel {
     r_prev: [Vec<f64>; 3],
     poisson: Poisson,
     fringe: Option<Fringe>,
+    trip: Option<Trip>,
     /// Per-plane partial sums, reduced in plane order.
     partial: Vec<f64>,
     /// The mean pressure gradient of the last stage (the drive, or what holds the flow rate).
@@ -123,6 +127,7 @@ impl Channel {
         Ok(Channel {
             poisson: Poisson::new(&grid),
             fringe: None,
+            trip: None,
             u: vec![0.0; cells],
             v: vec![0.0; faces],
             w: vec![0.0; cells],
@@ -346,10 +351,20 @@ impl Channel {
         self.fringe.as_ref()
     }
 
+    /// Adds a boundary-layer trip on the bottom wall.
+    pub fn set_trip(&mut self, spec: TripSpec) -> Result<(), ChannelError> {
+        let g = &self.grid;
+        self.trip = Some(Trip::new(spec, g.nx, g.dx, g.nz, g.lz)?);
+        Ok(())
+    }
+
     /// One time step (three stages).
     pub fn step(&mut self) -> Result<(), ChannelError> {
         let dt = self.cfg.dt;
         for s in 0..3 {
+            if let Some(trip) = &mut self.trip {
+                trip.at_time(self.time + STAGE_TIME[s] * dt);
+            }
             self.rhs();
             let (a, b) = (GAMMA[s] * dt, ZETA[s] * dt);
             for (x, (r, rp)) in [&mut self.u, &mut self.v, &mut self.w]
@@ -400,7 +415,7 @@ impl Channel {
             Drive::FlowRate(_) => 0.0,
         };
         let (nx, ny) = (g.nx, g.ny);
-        let fringe = self.fringe.as_ref();
+        let (fringe, trip) = (self.fringe.as_ref(), self.trip.as_ref());
         let [ru, rv, rw] = &mut self.r;
         ru.par_chunks_mut(nx)
             .zip(rw.par_chunks_mut(nx))
@@ -424,6 +439,9 @@ impl Channel {
                 if let Some(fr) = fringe {
                     let a = g.at_v(0, j, k);
                     fr.force_v_row(j, &f.v[a..a + nx], rv);
+                }
+                if let Some(t) = trip {
+                    t.force_v_row(g.yf[j], k, rv);
                 }
             });
     }
