@@ -65,6 +65,12 @@ impl SuctionSide {
         }
     }
 
+    /// The station data linearly interpolated at arc length `s` from the stagnation point.
+    pub fn at_s(&self, s: f64) -> Station {
+        let k = self.stations.partition_point(|p| p.s < s).clamp(1, self.x.len() - 1);
+        self.at(self.x[k - 1] + (s - self.stations[k - 1].s) / (self.stations[k].s - self.stations[k - 1].s) * (self.x[k] - self.x[k - 1]))
+    }
+
     /// Mean of `Re_theta` over the arc length between chordwise positions `x0` and `x1`.
     pub fn mean_re_theta(&self, x0: f64, x1: f64) -> f64 {
         let (mut sum, mut length) = (0.0, 0.0);
@@ -95,6 +101,9 @@ mod tests {
         // The adverse gradient thickens the layer: H grows and C_f falls over the control region.
         let (a, b) = (side.at(0.25), side.at(0.86));
         assert!(b.h > a.h && b.c_f < a.c_f && b.theta > 2.0 * a.theta);
+        // Arc length and chordwise position name the same stations.
+        let p = side.at(0.3);
+        assert!((side.at_s(p.s).ue - p.ue).abs() < 1e-9 && (side.at_s(p.s).theta - p.theta).abs() < 1e-12);
         let mean = side.mean_re_theta(0.25, 0.86);
         println!("mean Re_theta over x/c 0.25-0.86: {mean:.1}");
         assert!(mean > 200.0 && mean < 800.0, "{mean}");
