@@ -47,23 +47,9 @@ impl Layout {
             .bodies
             .first()
             .map_or(([0.0, 0.0], 1.0), |b| (b.center(), b.reference_length()));
-        let mut quantities = vec!["u", "v", "p"];
-        if spec.thermal.is_some() {
-            quantities.push("T");
-        }
-        let observations = spec
-            .probes
-            .iter()
-            .flat_map(|p| {
-                let at = [(p[0] - center[0]) / d, (p[1] - center[1]) / d];
-                quantities.iter().map(move |q| Channel {
-                    quantity: q.to_string(),
-                    at: Some(at),
-                })
-            })
-            .collect();
+        let quantities = with_temperature(&["u", "v", "p"], spec.thermal.is_some());
         Layout {
-            observations,
+            observations: probe_channels(&spec.probes, center, d, &quantities, str::to_string),
             actuators: actuator_names(&spec.actuation, center),
         }
     }
@@ -83,29 +69,43 @@ impl Layout {
             .bodies
             .first()
             .map_or(([0.0, 0.0], 1.0), |b| (b.center(), b.reference_length()));
-        let mut quantities = vec!["u", "v", "w", "p"];
-        if spec.thermal.is_some() {
-            quantities.push("T");
-        }
+        let quantities = with_temperature(&["u", "v", "w", "p"], spec.thermal.is_some());
         let segments = spec.segments();
         let name = |base: &str, s: usize| match segments {
             1 => base.to_string(),
             _ => format!("{base}@s{s}"),
         };
-        let mut observations = vec![];
-        for s in 0..segments {
-            for p in &spec.probes {
-                let at = [(p[0] - center[0]) / d, (p[1] - center[1]) / d];
-                observations.extend(quantities.iter().map(|q| Channel {
-                    quantity: name(q, s),
-                    at: Some(at),
-                }));
-            }
-        }
+        let observations = (0..segments)
+            .flat_map(|s| probe_channels(&spec.probes, center, d, &quantities, |q| name(q, s)))
+            .collect();
         let section = actuator_names(actuator, center);
         let actuators = (0..segments).flat_map(|s| section.iter().map(move |a| name(a, s))).collect();
         Layout { observations, actuators }
     }
+}
+
+/// The probed quantities, the temperature last when the flow carries one.
+fn with_temperature(velocity_and_pressure: &[&'static str], thermal: bool) -> Vec<&'static str> {
+    let mut q = velocity_and_pressure.to_vec();
+    if thermal {
+        q.push("T");
+    }
+    q
+}
+
+/// Each quantity at each probe (probe-major), placed relative to `center` in units of `d`.
+fn probe_channels(probes: &[[f64; 2]], center: [f64; 2], d: f64, quantities: &[&str], name: impl Fn(&str) -> String) -> Vec<Channel> {
+    probes
+        .iter()
+        .flat_map(|p| {
+            let at = [(p[0] - center[0]) / d, (p[1] - center[1]) / d];
+            quantities.iter().map(move |q| (at, *q))
+        })
+        .map(|(at, q)| Channel {
+            quantity: name(q),
+            at: Some(at),
+        })
+        .collect()
 }
 
 /// Names of the actuators, one per action.

@@ -137,7 +137,7 @@ pub fn analyse(p: &Protocol, root: &Path, r0: f64, episode_actions: usize) -> Re
     };
     for (run, (_, rows)) in runs.iter_mut().zip(&curves) {
         run.samples_to_threshold = if run.arm == "zeroshot" {
-            (threshold.is_finite() && run.final_return >= threshold).then_some(0)
+            (run.final_return >= threshold).then_some(0)
         } else {
             stays_above(rows, threshold)
         };
