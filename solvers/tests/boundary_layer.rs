@@ -4,7 +4,8 @@
 //! thickness and its shape factor downstream of the inflow. A trip forces where it is placed.
 
 use hgym_solvers::blasius::Blasius;
-use hgym_solvers::channel::{BaseFlow, Channel, ChannelConfig, Drive, FringeSpec, Top, TripSpec};
+use hgym_solvers::channel::plate::{plate as plate_flow, PlateSpec};
+use hgym_solvers::channel::{Channel, ChannelConfig, Drive, FringeSpec, Top, TripSpec};
 
 /// A Blasius layer entering at displacement thickness 1 (the length unit) with `Re_delta* = re`;
 /// `n` cells over the box `[lx, ly]`, the fringe over its last `fringe` lengths.
@@ -17,32 +18,32 @@ struct Plate {
 
 fn plate(n: [usize; 2], lx: f64, ly: f64, fringe: f64, re: f64, dt: f64) -> Plate {
     let nu = 1.0 / re;
-    let cfg = ChannelConfig {
+    let b = Blasius::solve();
+    let x0 = b.x_of_displacement(1.0, 1.0, nu);
+    let spec = PlateSpec {
         n: [n[0], n[1], 1],
         length: [lx, ly, 1.0],
         stretch: 1.5,
-        top: Top::FreeSlip,
         nu,
         dt,
-        drive: Drive::PressureGradient(0.0),
-        check_interval: 100,
+        fringe: FringeSpec {
+            x_start: lx - fringe,
+            x_end: lx,
+            rise: 0.3 * fringe,
+            fall: 0.3 * fringe,
+            lambda_max: 1.0,
+        },
+        modes: 4,
+        trip: None,
     };
-    let mut c = Channel::new(cfg).unwrap();
-    let b = Blasius::solve();
-    let x0 = b.x_of_displacement(1.0, 1.0, nu);
-    let g = c.grid().clone();
-    let spec = FringeSpec {
-        x_start: lx - fringe,
-        x_end: lx,
-        rise: 0.3 * fringe,
-        fall: 0.3 * fringe,
-        lambda_max: 1.0,
-    };
-    let base = BaseFlow::blended(&g, &spec, |_| 1.0, |x, y| b.velocity(x0 + x, y, 1.0, nu).0);
-    c.set_transpiration(&vec![0.0; g.nx], base.top()).unwrap();
-    c.set_velocity(&base.u, &base.v, &vec![0.0; g.nx * g.ny]).unwrap();
-    c.set_fringe(spec, base).unwrap();
-    Plate { c, b, nu, fringe: spec }
+    let (c, misfit) = plate_flow(&spec, |_| 1.0, |x, y| b.velocity(x0 + x, y, 1.0, nu).0).unwrap();
+    assert!(misfit < 1e-12, "a uniform free stream is one mode: {misfit}");
+    Plate {
+        c,
+        b,
+        nu,
+        fringe: spec.fringe,
+    }
 }
 
 /// At every `u` position upstream of the fringe: `x`, `C_f Re_theta` and the shape factor

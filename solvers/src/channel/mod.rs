@@ -7,6 +7,7 @@
 //! - [`operators`]: advection, diffusion, divergence and gradient, plane by plane;
 //! - [`poisson`]: the direct pressure solver;
 //! - [`fringe`]: the fringe forcing that turns the periodic box into a spatially developing flow;
+//! - [`plate`]: a flat-plate boundary layer under a given edge velocity (fringe, outflow, trip);
 //! - [`trip`]: the random volume force that trips a boundary layer;
 //! - [`solver`]: [`Channel`], time stepping, drive, transpiration and diagnostics;
 //! - [`stats`]: plane-averaged means and second moments.
@@ -19,6 +20,7 @@ pub mod fringe;
 pub mod grid;
 pub mod layer;
 pub mod operators;
+pub mod plate;
 pub mod poisson;
 pub mod solver;
 pub mod stats;
