@@ -527,7 +527,8 @@ pub struct EvalRun<'a> {
 
 impl EvalRun<'_> {
     /// Writes `dir/metrics.json` (the report) and `dir/manifest.json` (hgym/eval-manifest/v1).
-    pub fn write(&self, dir: &Path, report: &EvalReport, threads: usize, wall_s: f64) -> Result<()> {
+    /// `cpu_s`: the CPU time of the evaluation ([`hgym::report::manifest::CpuClock`]).
+    pub fn write(&self, dir: &Path, report: &EvalReport, threads: usize, wall_s: f64, cpu_s: Option<f64>) -> Result<()> {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
         std::fs::write(dir.join("metrics.json"), serde_json::to_string_pretty(report)? + "\n")?;
         let mut manifest = serde_json::json!({
@@ -539,7 +540,7 @@ impl EvalRun<'_> {
             "policy": self.policy,
             "eval_seed": self.eval_seed,
             "episodes": self.episodes,
-            "manifest": hgym::report::manifest::manifest(threads, wall_s),
+            "manifest": hgym::report::manifest::manifest(threads, wall_s).with_cpu(cpu_s),
         });
         if let (Some(toml), Some(m)) = (&self.config_toml, manifest.as_object_mut()) {
             m.insert("config_toml".into(), toml.clone().into());
@@ -582,6 +583,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
     };
     let (pool, threads) = thread_pool(args.threads)?;
     let started = std::time::Instant::now();
+    let cpu = hgym::report::manifest::CpuClock::start();
     if args.eval_seed.checked_add(args.episodes).is_none() {
         return Err(UsageError(format!(
             "--eval-seed {} + --episodes {} passes the largest seed ({}): give a smaller --eval-seed",
@@ -660,7 +662,7 @@ pub fn run_eval(args: EvalArgs) -> Result<Outcome> {
             episodes: args.episodes,
             config_toml: args.config.is_some().then(|| config.to_toml()),
         };
-        run.write(dir, &report, threads, started.elapsed().as_secs_f64())?;
+        run.write(dir, &report, threads, started.elapsed().as_secs_f64(), cpu.total(Some(0.0)))?;
         eprintln!("results: {}", dir.display());
     }
     if args.json {

@@ -171,8 +171,9 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
         p.seeds,
     );
     for a in &cmp.arms {
+        let measured = cmp.runs.iter().filter(|r| r.arm == a.arm).all(|r| r.core_hours_measured);
         println!(
-            "  {:<9} drag reduction {:+6.2} % +- {:.2}   episodes to threshold {:6.1} +- {:.1} ({} of {} seeds)   wall {:6.0} s   {:.2} core-h",
+            "  {:<9} drag reduction {:+6.2} % +- {:.2}   episodes to threshold {:6.1} +- {:.1} ({} of {} seeds)   wall {:6.0} s   {:.2} core-h ({})",
             a.arm,
             a.final_drag_reduction_pct.mean,
             a.final_drag_reduction_pct.std,
@@ -181,7 +182,8 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
             a.seeds_reaching,
             p.seeds.len(),
             a.wall_s.mean,
-            a.core_hours
+            a.core_hours,
+            if measured { "CPU time" } else { "wall x threads" }
         );
     }
     if cmp.episode_saving_pct.is_finite() {
@@ -210,6 +212,7 @@ fn episode_actions(spec: &hgym::env::Spec) -> Result<usize> {
 /// episodes, written as an `hgym eval --out` folder (metrics.json, manifest.json).
 fn zeroshot(p: &Protocol, src: &SourceRun, target: &hgym::env::Spec, dir: &std::path::Path, threads: usize) -> Result<()> {
     let started = Instant::now();
+    let cpu = hgym::report::manifest::CpuClock::start();
     let init = init_from(src, target, &p.mapping, false, false)?;
     let mut policy = init.policy;
     let n = p.config.train.final_eval_episodes.max(1) as u64;
@@ -237,5 +240,5 @@ fn zeroshot(p: &Protocol, src: &SourceRun, target: &hgym::env::Spec, dir: &std::
         episodes: n,
         config_toml: None,
     };
-    run.write(dir, &report, threads, started.elapsed().as_secs_f64())
+    run.write(dir, &report, threads, started.elapsed().as_secs_f64(), cpu.total(Some(0.0)))
 }

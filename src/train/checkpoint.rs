@@ -13,7 +13,7 @@ use crate::flow::Level;
 /// 4: the worker thread count; 3: TD3/DDPG learners with `gradient_steps`, `action_l2` and the
 /// warm start of a fine-tuned actor; 2: the algorithm by name and its learner's own bytes (1 held
 /// an enum over the learners). Format 3 is still read (its thread count unknown).
-pub const FORMAT: u32 = 4;
+pub const FORMAT: u32 = 5;
 pub const FILE: &str = "checkpoint.bin";
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -37,8 +37,12 @@ pub struct Checkpoint {
     pub resumed: u32,
     /// Worker threads of the session that wrote it (`None` from format 3): a run is bitwise
     /// repeatable for the same seed and thread count, so a resume keeps this count. Stays the
-    /// last field (`load` reads format 3 by appending it).
+    /// field before `cpu_s` (`load` reads format 3 by appending it).
     pub threads: Option<usize>,
+    /// CPU time spent before this checkpoint, over all sessions of the run (`None` from format
+    /// 4, or when a session could not measure it). Stays the last field (`load` reads formats 3
+    /// and 4 by appending it).
+    pub cpu_s: Option<f64>,
 }
 
 /// Why a checkpoint could not be written or read back.
@@ -97,11 +101,13 @@ pub fn load(dir: &Path) -> Result<Checkpoint, CheckpointError> {
         Ok(b) => b,
         Err(source) => return Err(CheckpointError::Read { path, source }),
     };
-    // Every format starts with its number. bincode writes the fields in order, so format 3 is
-    // format 4 without the trailing `threads`: one byte 0 (`None`) appended makes it one.
+    // Every format starts with its number. bincode writes the fields in order, so format 4 is
+    // format 5 without the trailing `cpu_s`, and format 3 also lacks `threads` before it: one byte
+    // 0 (`None`) appended per missing field makes them format 5.
     let decoded = match bincode::deserialize::<u32>(&bytes) {
         Ok(FORMAT) => bincode::deserialize::<Checkpoint>(&bytes),
-        Ok(3) => bincode::deserialize::<Checkpoint>(&[bytes.as_slice(), &[0]].concat()),
+        Ok(4) => bincode::deserialize::<Checkpoint>(&[bytes.as_slice(), &[0]].concat()),
+        Ok(3) => bincode::deserialize::<Checkpoint>(&[bytes.as_slice(), &[0, 0]].concat()),
         Ok(found) => return Err(CheckpointError::Format { path, found }),
         Err(source) => Err(source),
     };
@@ -126,6 +132,7 @@ mod tests {
             wall_s: 2.5,
             resumed: 1,
             threads,
+            cpu_s: None,
         }
     }
 
@@ -135,20 +142,36 @@ mod tests {
         save(dir.path(), &sample(Some(2))).unwrap();
         let ck = load(dir.path()).unwrap();
         assert_eq!(ck.threads, Some(2));
+        assert_eq!(ck.cpu_s, None);
+        let mut with_cpu = sample(Some(2));
+        with_cpu.cpu_s = Some(12.5);
+        save(dir.path(), &with_cpu).unwrap();
+        assert_eq!(load(dir.path()).unwrap().cpu_s, Some(12.5));
         assert_eq!((ck.seed, ck.learner, ck.resumed), (7, vec![1, 2, 3], 1));
     }
 
     #[test]
     fn format_3_reads_with_the_thread_count_unknown() {
         let dir = tempfile::tempdir().unwrap();
-        // bincode writes the fields in order: format 3 is format 4 without the trailing
-        // `threads` (`None`, one byte) and with another number in front.
+        // bincode writes the fields in order: format 3 is format 5 without the trailing
+        // `threads` and `cpu_s` (`None`, one byte each) and with another number in front.
         let mut bytes = bincode::serialize(&sample(None)).unwrap();
-        assert_eq!(bytes.pop(), Some(0));
+        assert_eq!((bytes.pop(), bytes.pop()), (Some(0), Some(0)));
         bytes[..4].copy_from_slice(&3u32.to_le_bytes());
         std::fs::write(dir.path().join(FILE), bytes).unwrap();
         let ck = load(dir.path()).unwrap();
-        assert_eq!((ck.format, ck.threads, ck.seed, ck.wall_s), (3, None, 7, 2.5));
+        assert_eq!((ck.format, ck.threads, ck.cpu_s, ck.seed, ck.wall_s), (3, None, None, 7, 2.5));
+    }
+
+    #[test]
+    fn format_4_reads_with_the_cpu_time_unknown() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut bytes = bincode::serialize(&sample(Some(2))).unwrap();
+        assert_eq!(bytes.pop(), Some(0));
+        bytes[..4].copy_from_slice(&4u32.to_le_bytes());
+        std::fs::write(dir.path().join(FILE), bytes).unwrap();
+        let ck = load(dir.path()).unwrap();
+        assert_eq!((ck.format, ck.threads, ck.cpu_s), (4, Some(2), None));
     }
 
     #[test]
@@ -158,7 +181,7 @@ mod tests {
         c.format = 2;
         save(dir.path(), &c).unwrap();
         match load(dir.path()) {
-            Err(e @ CheckpointError::Format { found: 2, .. }) => assert!(e.to_string().contains("formats 3 to 4"), "{e}"),
+            Err(e @ CheckpointError::Format { found: 2, .. }) => assert!(e.to_string().contains("formats 3 to 5"), "{e}"),
             other => panic!("expected a format error, got {other:?}"),
         }
     }

@@ -40,7 +40,7 @@ use self::curve::CurveRow;
 use self::eval::{evaluate, uncontrolled, EvalReport, LiftDeviationStat, Stat, Uncontrolled};
 use crate::env::{FlowEnv, Spec};
 use crate::flow::Level;
-use crate::report::manifest::{manifest, Manifest};
+use crate::report::manifest::{manifest, CpuClock, Manifest};
 
 #[derive(Debug, thiserror::Error)]
 pub enum TrainError {
@@ -192,6 +192,7 @@ pub fn train(
     interrupted: &dyn Fn() -> bool,
 ) -> Result<Ending, TrainError> {
     let started = Instant::now();
+    let cpu = CpuClock::start();
     let config = &opts.config;
     let spec = resolve_spec(&opts.env_id, config)?;
     let algo = algorithm(&opts.algo).map_err(|e| TrainError::Input(e.to_string()))?;
@@ -237,10 +238,10 @@ pub fn train(
         )
     };
 
-    let (mut learner, mut curve, reference, wall_before, resumed) = match resume {
+    let (mut learner, mut curve, reference, wall_before, cpu_before, resumed) = match resume {
         Some(ck) => {
             let learner = algo.decode(&ck.learner)?;
-            (learner, ck.curve, ck.reference, ck.wall_s, ck.resumed + 1)
+            (learner, ck.curve, ck.reference, ck.wall_s, ck.cpu_s, ck.resumed + 1)
         }
         None => {
             let mut learner = algo.learner(&config.algos, obs_dim, act_dim, opts.seed)?;
@@ -267,11 +268,11 @@ pub fn train(
                 start.set_eval(&r);
                 curve.push(start);
             }
-            (learner, curve, reference, 0.0, 0)
+            (learner, curve, reference, 0.0, Some(0.0), 0)
         }
     };
     let config_toml = config.to_toml();
-    let checkpoint = |learner: &dyn Learner, curve: &[CurveRow], wall_s: f64| {
+    let checkpoint = |learner: &dyn Learner, curve: &[CurveRow]| {
         checkpoint::save(
             &opts.out,
             &Checkpoint {
@@ -284,9 +285,10 @@ pub fn train(
                 learner: learner.to_bytes()?,
                 curve: curve.to_vec(),
                 reference: reference.clone(),
-                wall_s,
+                wall_s: wall_before + started.elapsed().as_secs_f64(),
                 resumed,
                 threads: Some(rayon::current_num_threads()),
+                cpu_s: cpu.total(cpu_before),
             },
         )?;
         // The curve so far, to follow a long run from another terminal.
@@ -297,7 +299,7 @@ pub fn train(
     // before its first round); every run saves after its first round, then every
     // `checkpoint_seconds`, so a short run killed early can still resume.
     if resumed > 0 {
-        checkpoint(&*learner, &curve, wall_before)?;
+        checkpoint(&*learner, &curve)?;
     }
     let mut last_ckpt: Option<Instant> = None;
     let mut last_eval = curve
@@ -307,7 +309,7 @@ pub fn train(
         .map(|r| (r.eval_return, r.eval_drag_reduction_pct));
     while learner.samples() < config.train.steps {
         if interrupted() {
-            checkpoint(&*learner, &curve, wall_before + started.elapsed().as_secs_f64())?;
+            checkpoint(&*learner, &curve)?;
             return Ok(Ending::Interrupted {
                 samples: learner.samples(),
             });
@@ -345,12 +347,12 @@ pub fn train(
         });
         curve.push(row);
         if last_ckpt.is_none_or(|t| t.elapsed().as_secs_f64() >= config.train.checkpoint_seconds) {
-            checkpoint(&*learner, &curve, wall_before + started.elapsed().as_secs_f64())?;
+            checkpoint(&*learner, &curve)?;
             last_ckpt = Some(Instant::now());
         }
     }
     let wall = wall_before + started.elapsed().as_secs_f64();
-    checkpoint(&*learner, &curve, wall)?;
+    checkpoint(&*learner, &curve)?;
 
     // Final evaluation on its own seeds, against the uncontrolled flow from the same states.
     let final_seeds = eval_seeds(config, config.train.final_eval_episodes.max(1));
@@ -409,7 +411,7 @@ pub fn train(
         resumed,
         config_toml,
         init_from: read_init(&opts.out)?,
-        manifest: manifest(rayon::current_num_threads(), wall),
+        manifest: manifest(rayon::current_num_threads(), wall).with_cpu(cpu.total(cpu_before)),
     };
     write_json(&opts.out.join("manifest.json"), "the manifest", &m)?;
     Ok(Ending::Finished(Box::new(report)))

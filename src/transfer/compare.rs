@@ -10,8 +10,9 @@
 //! from-scratch arm ends at or below the uncontrolled return there is no gain to reach a fraction
 //! of: the threshold is undefined (`null`), no arm reaches it, and no saving is reported.
 //! Final drag reductions and returns are each run's final evaluation (`metrics.json`). Cost is
-//! core-hours: wall time times threads; the cost to threshold scales a run's core-hours by the
-//! fraction of its samples spent before reaching the threshold.
+//! core-hours: the run's measured CPU time (manifest `cpu_time_s`, which a shared machine does not
+//! inflate), or wall time times threads for runs that predate that clock; the cost to threshold
+//! scales a run's core-hours by the fraction of its samples spent before reaching the threshold.
 
 use std::path::{Path, PathBuf};
 
@@ -34,6 +35,8 @@ pub struct ArmRun {
     pub samples_to_threshold: Option<u64>,
     pub wall_s: f64,
     pub core_hours: f64,
+    /// Whether `core_hours` is measured CPU time (else wall time times threads).
+    pub core_hours_measured: bool,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -92,12 +95,16 @@ fn json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, CompareError> 
     })
 }
 
-/// Wall time and threads of a result folder's `manifest.json` (train or eval).
-fn cost(dir: &Path) -> Result<(f64, f64), CompareError> {
+/// Wall time, core-hours and whether those were measured as CPU time, from a result folder's
+/// `manifest.json` (train or eval).
+fn cost(dir: &Path) -> Result<(f64, f64, bool), CompareError> {
     let m: serde_json::Value = json(&dir.join("manifest.json"))?;
     let wall = m["manifest"]["wall_time_s"].as_f64().unwrap_or(f64::NAN);
     let threads = m["manifest"]["threads"].as_f64().unwrap_or(f64::NAN);
-    Ok((wall, wall * threads / 3600.0))
+    Ok(match m["manifest"]["cpu_time_s"].as_f64() {
+        Some(cpu) => (wall, cpu / 3600.0, true),
+        None => (wall, wall * threads / 3600.0, false),
+    })
 }
 
 /// Reads every arm of every seed under `root` and compares them; writes `transfer.png`.
@@ -108,7 +115,7 @@ pub fn analyse(p: &Protocol, root: &Path, r0: f64, episode_actions: usize) -> Re
         for &seed in &p.seeds {
             let dir = p.arm_dir(root, arm, seed);
             let report: EvalReport = json(&dir.join("metrics.json"))?;
-            let (wall_s, core_hours) = cost(&dir)?;
+            let (wall_s, core_hours, core_hours_measured) = cost(&dir)?;
             let rows = if arm == "zeroshot" {
                 vec![]
             } else {
@@ -125,6 +132,7 @@ pub fn analyse(p: &Protocol, root: &Path, r0: f64, episode_actions: usize) -> Re
                 samples_to_threshold: None,
                 wall_s,
                 core_hours,
+                core_hours_measured,
             });
             curves.push((arm.into(), rows));
         }
