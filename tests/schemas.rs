@@ -12,6 +12,7 @@ fn schema_file(path: &Path, v: &serde_json::Value) -> Option<&'static str> {
         Some("hgym/validation/v1") => Some("validation.schema.json"),
         Some("hgym/kolmogorov-validation/v1") => Some("kolmogorov-validation.schema.json"),
         Some("hgym/channel-validation/v1") => Some("channel-validation.schema.json"),
+        Some("hgym/tbl-validation/v1") => Some("tbl-validation.schema.json"),
         Some("hgym/train/v1") => Some("train.schema.json"),
         Some("hgym/eval/v1") => Some("eval.schema.json"),
         Some("hgym/eval-manifest/v1") => Some("eval-manifest.schema.json"),

@@ -85,6 +85,9 @@ pub fn run(args: ValidateArgs) -> Result<Outcome> {
     if args.names == ["channel"] || args.names == ["channel_retau180"] {
         return run_channel(&args);
     }
+    if args.names == ["tbl"] || args.names == ["tbl_zpg"] {
+        return run_tbl(&args);
+    }
     if args.list {
         for c in validate::bundled()? {
             println!("{:<10} {:<18} {}", c.case.case.family, c.case.case.name, c.case.case.description);
@@ -94,9 +97,11 @@ pub fn run(args: ValidateArgs) -> Result<Outcome> {
         println!("{:<10} {:<18} {}", "kolmogorov", k.case, k.description);
         let c = hgym::validate::channel::case().context("the bundled case channel_retau180.toml")?;
         println!("{:<10} {:<18} {}", "channel", c.case, c.description);
+        let t = hgym::validate::plate::case().context("the bundled case tbl_zpg.toml")?;
+        println!("{:<10} {:<18} {}", "tbl", t.case, t.description);
         return Ok(Outcome::Ok);
     }
-    for own in ["kolmogorov", "channel"] {
+    for own in ["kolmogorov", "channel", "tbl"] {
         if args.names.len() > 1 && args.names.iter().any(|n| n == own) {
             return Err(UsageError(format!("run `hgym validate {own}` on its own")).into());
         }
@@ -233,6 +238,68 @@ fn run_envs(args: &ValidateArgs) -> Result<Outcome> {
     Ok(if all_pass { Outcome::Ok } else { Outcome::CheckFailed })
 }
 
+/// `hgym validate tbl`: the zero-pressure-gradient turbulent boundary layer against DNS.
+fn run_tbl(args: &ValidateArgs) -> Result<Outcome> {
+    use hgym::validate::plate;
+    let (pool, _) = thread_pool(args.threads)?;
+    let case = plate::case().context("the bundled case benchmarks/validation/tbl_zpg.toml")?;
+    let l = case.level(args.level).clone();
+    let cache = hgym::env::default_cache_dir();
+    if !args.json {
+        eprintln!(
+            "tbl_zpg ({}): {}x{}x{} cells on {} x {} x {} delta*_0 (Re_delta*_0 {}), dt {}; spin-up {} (cached after the first run), average {} delta*_0/U",
+            args.level.name(), l.n[0], l.n[1], l.n[2], case.length[0], case.length[1], case.length[2], case.re_delta_star, l.dt, l.spin_up, l.average
+        );
+    }
+    let mut pb: Option<Progress> = None;
+    let r = pool
+        .install(|| {
+            plate::validate(args.level, &args.out, cache.as_deref(), &mut |done, total| {
+                pb.get_or_insert_with(|| Progress::new(total, "boundary layer")).set_position(done)
+            })
+        })
+        .map_err(|e| match e {
+            plate::PlateValidationError::Unrunnable(_) => anyhow::Error::new(UsageError(e.to_string())),
+            e => anyhow::Error::new(e).context("boundary-layer validation"),
+        })?;
+    if let Some(pb) = pb {
+        pb.finish_and_clear();
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&r)?);
+    } else {
+        println!(
+            "tbl_zpg ({}, {}x{}x{}, {} samples over {} delta*_0/U; dx+ {:.1}, dz+ {:.1}, first cell y+ {:.2}; Ue spread {:.2} %):",
+            r.level,
+            r.n[0],
+            r.n[1],
+            r.n[2],
+            r.samples,
+            r.average,
+            r.dx_plus,
+            r.dz_plus,
+            r.first_cell_y_plus,
+            100.0 * r.ue_spread
+        );
+        print_checks(&r.checks);
+        println!("  results: {}", args.out.join("tbl_zpg.json").display());
+    }
+    Ok(if r.pass { Outcome::Ok } else { Outcome::CheckFailed })
+}
+
+fn print_checks(checks: &[hgym::validate::channel::Check]) {
+    for c in checks {
+        println!(
+            "  {} {:<40} {:>10.5} (reference {:.5}, tolerance {})",
+            if c.pass { "pass" } else { "FAIL" },
+            c.name,
+            c.value,
+            c.reference,
+            c.tolerance
+        );
+    }
+}
+
 /// `hgym validate channel`: the turbulent channel at Re_tau 180 against the DNS databases.
 fn run_channel(args: &ValidateArgs) -> Result<Outcome> {
     use hgym::validate::channel;
@@ -268,16 +335,7 @@ fn run_channel(args: &ValidateArgs) -> Result<Outcome> {
             "channel_retau180 ({}, {}x{}x{}, {} samples over {} h/U_b; first cell y+ {:.2}):",
             r.level, r.n[0], r.n[1], r.n[2], r.samples, r.average, r.first_cell_y_plus
         );
-        for c in &r.checks {
-            println!(
-                "  {} {:<40} {:>10.5} (reference {:.5}, tolerance {})",
-                if c.pass { "pass" } else { "FAIL" },
-                c.name,
-                c.value,
-                c.reference,
-                c.tolerance
-            );
-        }
+        print_checks(&r.checks);
         println!("  results: {}", args.out.join("channel_retau180.json").display());
     }
     Ok(if r.pass { Outcome::Ok } else { Outcome::CheckFailed })

@@ -164,7 +164,7 @@ fn cache_path(dir: &Path, c: &Case, level: Level) -> PathBuf {
 }
 
 /// `(x, y)` table columns `cx`, `cy` of a CSV with `#` comment lines and a header.
-fn columns(text: &str, cx: usize, cy: usize) -> Result<(Vec<f64>, Vec<f64>), ChannelValidationError> {
+pub(crate) fn columns(text: &str, cx: usize, cy: usize) -> Result<(Vec<f64>, Vec<f64>), ChannelValidationError> {
     let (mut xs, mut ys) = (vec![], vec![]);
     for line in text.lines().filter(|l| !l.starts_with('#')).skip(1) {
         let f: Vec<&str> = line.split(',').collect();

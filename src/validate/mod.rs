@@ -11,6 +11,7 @@
 pub mod analysis;
 pub mod case;
 pub mod channel;
+pub mod plate;
 pub mod report;
 pub mod run;
 pub mod series;
