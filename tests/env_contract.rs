@@ -16,8 +16,9 @@ fn check_env_passes_over_every_spectral_id() {
         if spec.downcast::<hgym::env::EnvSpec>().is_some()
             || spec.downcast::<hgym::env::spec3::Env3Spec>().is_some()
             || spec.downcast::<hgym::env::channel::ChannelSpec>().is_some()
+            || spec.downcast::<hgym::env::wing_tbl::WingTblSpec>().is_some()
         {
-            continue; // checked with more below, in env3_contract.rs and in channel_env.rs
+            continue; // checked with more below, in env3_contract.rs, channel_env.rs and wing_tbl.rs
         }
         let mut over = toml::Table::new();
         over.insert("episode_actions".into(), toml::Value::Integer(3));

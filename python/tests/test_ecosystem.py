@@ -30,6 +30,8 @@ for e in hgym.envs():
     FIRST.setdefault(e["family"], e["id"])
     lbm_3d = e["dimension"] == 3 and e["solver"].startswith("lbm")
     SHORTS[e["id"]] = {**SHORT, "spin_up": 0.1, "control_interval": 0.005} if lbm_3d else SHORT
+    if e["family"] == "wing_tbl":
+        SHORTS[e["id"]] = {**SHORT, "spin_up": 0.002}
 FAMILIES = list(FIRST.values())
 
 @pytest.mark.parametrize("env_id", FAMILIES)

@@ -22,7 +22,12 @@ SHORT = {"episode_actions": 3}
 # The 3D lattice-Boltzmann flows (coarse grids of 0.7 to 4 million nodes) also get a spin-up and a
 # control interval of a few lattice steps, on their registered grids.
 SHORT_3D = {**SHORT, "spin_up": 0.1, "control_interval": 0.005}
-SHORTS = {e["id"]: SHORT_3D if e["dimension"] == 3 and e["solver"].startswith("lbm") else SHORT for e in hgym.envs()}
+# The wing's boundary layer (a plate of 0.6 million cells at coarse) gets a spin-up of a few steps.
+SHORT_WING = {**SHORT, "spin_up": 0.002}
+SHORTS = {
+    e["id"]: SHORT_3D if e["dimension"] == 3 and e["solver"].startswith("lbm") else SHORT_WING if e["family"] == "wing_tbl" else SHORT
+    for e in hgym.envs()
+}
 # Gymnasium's checker runs over every 2D and spectral ID, and over the first 3D lattice-Boltzmann ID
 # of each family: the binding is one code path per family (each 3D check costs 3-27 s here); the
 # Rust contract checks every 3D ID in `make nightly` (tests/env3_contract.rs, an ignored test).

@@ -35,6 +35,7 @@ pub mod spec3;
 pub mod sphere;
 pub mod spin_up;
 pub mod square;
+pub mod wing_tbl;
 
 pub use family::{FlowEnv, Spec};
 pub use lbm_env::LbmEnv;

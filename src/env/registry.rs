@@ -2,7 +2,7 @@
 
 use super::family::{Family, Spec};
 use super::spec::EnvSpec;
-use super::{calibrate, cavity, channel, cube, cylinder, kolmogorov, naca, pinball, pipe, sphere, square, EnvInputError};
+use super::{calibrate, cavity, channel, cube, cylinder, kolmogorov, naca, pinball, pipe, sphere, square, wing_tbl, EnvInputError};
 
 /// The families, in listing order. A new family is one file implementing [`Family`] and one
 /// line here.
@@ -17,6 +17,7 @@ pub const FAMILIES: &[&dyn Family] = &[
     &cube::Cube,
     &kolmogorov::KolmogorovFlows,
     &channel::Channels,
+    &wing_tbl::WingTbls,
 ];
 
 /// All registered specs, in a fixed order, with their committed statistics.

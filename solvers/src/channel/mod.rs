@@ -25,6 +25,7 @@ pub mod poisson;
 pub mod solver;
 pub mod stats;
 pub mod trip;
+pub mod wing_plate;
 
 pub use error::ChannelError;
 pub use fringe::{BaseFlow, Fringe, FringeSpec};

@@ -156,6 +156,11 @@ impl Channel {
     pub fn steps(&self) -> u64 {
         self.step
     }
+    /// Sets the clock (a restored state's time: the trip's forcing depends on it).
+    pub fn set_clock(&mut self, steps: u64, time: f64) {
+        self.step = steps;
+        self.time = time;
+    }
     /// `u` on the x-faces, `at(i, j, k)` order.
     pub fn u(&self) -> &[f64] {
         &self.u
