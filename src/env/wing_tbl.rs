@@ -20,10 +20,11 @@
 //!   velocities over the control region is removed (zero net mass flux, as in the surrogate).
 //!   Held over a control interval `dt+ = 0.6` with `t* = nu / <u_tau>^2` of the region.
 //! - Observations: `u'` and `v'` at the local `y+ = 15` (spanwise means removed), averaged over
-//!   each patch and divided by the local `u_tau`, over the control region's patches and one
-//!   column of sensing patches beyond each of its ends (`agents.window` columns): the agents at
-//!   the ends see the flow that enters and leaves their region. Columns in x-fastest order,
-//!   `[u'_0, v'_0, u'_1, v'_1, ...]`, rows in z.
+//!   each patch and divided by the local `u_tau`: first over the actuated patches in the action's
+//!   order (x fastest, then z), `[u'_0, v'_0, u'_1, v'_1, ...]` (so a baseline reading `v'` of
+//!   action `j` at `2 j + 1` works as in the channel), then over the sensing patches of the
+//!   `agents.window` columns beyond each end of the region (upstream columns first, rows in z):
+//!   the agents at the ends see the flow that enters and leaves their region.
 //! - Reward: `1 - tau_w / tau_w,ref` over the control region, `tau_w,ref` the uncontrolled one.
 //!   `info`: `C_f` of the region (`2 tau_w / <Ue>^2`), and as `C_D` the friction drag coefficient
 //!   of the whole plate upstream of the fringe (`2 / c` times the integral of `tau_w` over x),
@@ -140,6 +141,18 @@ impl Layout {
         let i = self.column_start(c);
         self.u_tau[i..i + self.bx].iter().sum::<f64>() / self.bx as f64
     }
+    /// Index of the `(u', v')` pair of sensing column `c`, patch row `qz` in the observation:
+    /// the actuated patches first, in the action's order, then the columns beyond the ends.
+    fn slot(&self, c: usize, qz: usize) -> usize {
+        let m = self.margin;
+        if (m..m + self.px).contains(&c) {
+            qz * self.px + c - m
+        } else {
+            let e = if c < m { c } else { c - self.px };
+            self.px * self.pz + qz * 2 * m + e
+        }
+    }
+
     /// Mean friction velocity over the control region.
     fn region_u_tau(&self) -> f64 {
         let r = &self.u_tau[self.i0..self.i0 + self.px * self.bx];
@@ -642,7 +655,7 @@ impl WingTblEnv {
                 let (mu, mv) = (mu / g.nz as f64, mv / g.nz as f64);
                 for k in 0..g.nz {
                     let (du, dv) = ((uc(k) - mu) / u_tau, (vc(k) - mv) / u_tau);
-                    let o = 2 * ((k / l.bz) * l.columns() + c);
+                    let o = 2 * l.slot(c, k / l.bz);
                     obs[o] += du / (l.bx * l.bz) as f64;
                     obs[o + 1] += dv / (l.bx * l.bz) as f64;
                     u2 += du * du;
@@ -810,8 +823,8 @@ impl Env for WingTblEnv {
                 for dz in -w..=w {
                     for dx in -w..=w {
                         let z = (qz as isize + dz).rem_euclid(l.pz as isize) as usize;
-                        let c = (l.margin + qx) as isize + dx;
-                        let o = 2 * (z * l.columns() + c as usize);
+                        let c = ((l.margin + qx) as isize + dx) as usize;
+                        let o = 2 * l.slot(c, z);
                         seen.extend([o, o + 1]);
                     }
                 }
@@ -986,8 +999,19 @@ mod tests {
         assert_eq!(a.obs.len(), l.px * l.pz);
         // 3 x 3 patches of (u', v'), as in the channel with window 1.
         assert!(a.obs.iter().all(|o| o.len() == 18));
-        // The first agent's upstream neighbours are the sensing column before the region.
-        assert_eq!(a.obs[0][..2], [2 * (l.columns() * (l.pz - 1)), 2 * (l.columns() * (l.pz - 1)) + 1]);
+        // The first agent's upstream neighbours are the sensing column before the region; its
+        // own patch is the first action's.
+        let up = 2 * l.slot(0, l.pz - 1);
+        assert_eq!(a.obs[0][..2], [up, up + 1]);
+        assert!(up >= 2 * l.px * l.pz);
+        assert_eq!(a.obs[0][8..10], [0, 1]);
+        // Every observation slot is one sensing patch.
+        let mut slots: Vec<usize> = (0..l.columns())
+            .flat_map(|c| (0..l.pz).map(move |z| (c, z)))
+            .map(|(c, z)| l.slot(c, z))
+            .collect();
+        slots.sort();
+        assert_eq!(slots, (0..l.columns() * l.pz).collect::<Vec<_>>());
     }
 
     #[test]
