@@ -365,6 +365,31 @@ impl FamilySpec for ChannelSpec {
     fn calibrated(&self) -> bool {
         self.statistics.tau_w > 0.0
     }
+    /// One agent per patch ([`ChannelAgents`]); the patch numbering is the action's.
+    fn decomposition(&self) -> Option<Agents> {
+        let [px, pz] = self.patches;
+        let w = self.agents.window as isize;
+        let (mut obs, mut act) = (vec![], vec![]);
+        for wall in 0..self.walls() {
+            for qz in 0..pz {
+                for qx in 0..px {
+                    let mut seen = vec![];
+                    for dz in -w..=w {
+                        for dx in -w..=w {
+                            let z = (qz as isize + dz).rem_euclid(pz as isize) as usize;
+                            let x = (qx as isize + dx).rem_euclid(px as isize) as usize;
+                            let q = wall * px * pz + z * px + x;
+                            seen.extend([2 * q, 2 * q + 1]);
+                        }
+                    }
+                    obs.push(seen);
+                    act.push(vec![wall * px * pz + qz * px + qx]);
+                }
+            }
+        }
+        Agents::new(self.obs_dim(), self.act_dim(), obs, act, self.agents.reward).ok()
+    }
+
     /// A box smaller than the minimal flow unit in viscous units (Jimenez & Moin 1991: about
     /// `Lx+ 250-350` by `Lz+ 100`) may not sustain turbulence at this Re_tau.
     fn warnings(&self) -> Vec<String> {
@@ -774,27 +799,7 @@ impl Env for ChannelEnv {
 
     /// One agent per patch ([`ChannelAgents`]); the patch numbering is the action's.
     fn agents(&self) -> Option<Agents> {
-        let [px, pz] = self.spec.patches;
-        let w = self.spec.agents.window as isize;
-        let (mut obs, mut act) = (vec![], vec![]);
-        for wall in 0..self.spec.walls() {
-            for qz in 0..pz {
-                for qx in 0..px {
-                    let mut seen = vec![];
-                    for dz in -w..=w {
-                        for dx in -w..=w {
-                            let z = (qz as isize + dz).rem_euclid(pz as isize) as usize;
-                            let x = (qx as isize + dx).rem_euclid(px as isize) as usize;
-                            let q = wall * px * pz + z * px + x;
-                            seen.extend([2 * q, 2 * q + 1]);
-                        }
-                    }
-                    obs.push(seen);
-                    act.push(vec![wall * px * pz + qz * px + qx]);
-                }
-            }
-        }
-        Agents::new(self.spec.obs_dim(), self.spec.act_dim(), obs, act, self.spec.agents.reward).ok()
+        FamilySpec::decomposition(&self.spec)
     }
 
     /// `1 - tau_w,patch / tau_w,ref` per patch over the last interval.

@@ -53,6 +53,12 @@ pub trait FamilySpec: Any + Send + Sync + std::fmt::Debug {
     fn differentiable(&self) -> bool {
         false
     }
+    /// How its environments split into agents (`Env::agents`), where the spec alone tells (the
+    /// wall-actuated flows: one agent per patch). Transfer reads it to move a shared actor onto
+    /// another flow's agents.
+    fn decomposition(&self) -> Option<hgym_agents::multi::Agents> {
+        None
+    }
     /// Whether committed observation statistics are attached.
     fn calibrated(&self) -> bool;
     /// Things that run but may not give what the user wants (the commands print them).

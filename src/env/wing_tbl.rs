@@ -411,6 +411,31 @@ impl FamilySpec for WingTblSpec {
     fn calibrated(&self) -> bool {
         !self.statistics.tau_w.is_empty()
     }
+    /// One agent per patch: it sees the `(2 window + 1)^2` sensing patches centred on its own
+    /// (periodic in z; in x the sensing columns reach `window` beyond the region), acts on its
+    /// own patch and learns from the region's reward.
+    fn decomposition(&self) -> Option<Agents> {
+        let l = self.layout(Level::Default).ok()?;
+        let w = self.agents.window as isize;
+        let (mut obs, mut act) = (vec![], vec![]);
+        for qz in 0..l.pz {
+            for qx in 0..l.px {
+                let mut seen = vec![];
+                for dz in -w..=w {
+                    for dx in -w..=w {
+                        let z = (qz as isize + dz).rem_euclid(l.pz as isize) as usize;
+                        let c = ((l.margin + qx) as isize + dx) as usize;
+                        let o = 2 * l.slot(c, z);
+                        seen.extend([o, o + 1]);
+                    }
+                }
+                obs.push(seen);
+                act.push(vec![qz * l.px + qx]);
+            }
+        }
+        Agents::new(self.obs_dim(), self.act_dim(), obs, act, self.agents.reward).ok()
+    }
+
     fn hash(&self) -> String {
         WingTblSpec::hash(self)
     }
@@ -810,29 +835,9 @@ impl Env for WingTblEnv {
         })
     }
 
-    /// One agent per patch: it sees the `(2 window + 1)^2` sensing patches centred on its own
-    /// (periodic in z; in x the sensing columns reach `window` beyond the region), acts on its
-    /// own patch and learns from the region's reward.
+    /// One agent per patch ([`WingTblSpec::decomposition`]).
     fn agents(&self) -> Option<Agents> {
-        let l = &self.layout;
-        let w = self.spec.agents.window as isize;
-        let (mut obs, mut act) = (vec![], vec![]);
-        for qz in 0..l.pz {
-            for qx in 0..l.px {
-                let mut seen = vec![];
-                for dz in -w..=w {
-                    for dx in -w..=w {
-                        let z = (qz as isize + dz).rem_euclid(l.pz as isize) as usize;
-                        let c = ((l.margin + qx) as isize + dx) as usize;
-                        let o = 2 * l.slot(c, z);
-                        seen.extend([o, o + 1]);
-                    }
-                }
-                obs.push(seen);
-                act.push(vec![qz * l.px + qx]);
-            }
-        }
-        Agents::new(self.spec.obs_dim(), self.spec.act_dim(), obs, act, self.spec.agents.reward).ok()
+        FamilySpec::decomposition(&self.spec)
     }
 
     /// `1 - tau_w,patch / tau_w,ref` per patch over the last interval.

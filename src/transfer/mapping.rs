@@ -10,7 +10,8 @@
 //! ```
 //!
 //! Every source observation is read from the target observation of the same quantity at the same
-//! position relative to the body (or, for observations known by index, of the same name).
+//! position relative to the body (or, for observations known by index, of the same name, and
+//! only between flows with as many observations).
 //! Without `[mapping.actions]`, actuators of equal names drive each other; a target actuator with
 //! no source stays at zero.
 
@@ -68,6 +69,16 @@ pub fn resolve(source: (&str, &Layout), target: (&str, &Layout), spec: &MappingS
     let (src, dst) = (source.1, target.1);
     if !(spec.tolerance.is_finite() && spec.tolerance >= 0.0) {
         return Err(err(format!("[mapping] tolerance must be a distance >= 0, got {}", spec.tolerance)));
+    }
+    // Observations known by index mean the same thing only on flows of the same shape.
+    let indexed = |l: &Layout| l.observations.iter().all(|c| c.at.is_none() && c.quantity.starts_with("obs"));
+    if (indexed(src) || indexed(dst)) && src.observations.len() != dst.observations.len() {
+        return Err(err(format!(
+            "the observations are known only by index and the flows have {} and {} of them: nothing says which \
+             source observation a target one is",
+            src.observations.len(),
+            dst.observations.len()
+        )));
     }
     let obs = src
         .observations

@@ -118,9 +118,21 @@ impl SourceRun {
     }
 
     /// The map onto `target` and the policy rewritten for it.
+    ///
+    /// A shared multi-agent actor reads one agent's neighbourhood: it moves onto a target whose
+    /// spec splits it into agents of the same local sizes (the channel's patches onto the wing's:
+    /// both see `u'` and `v'` at `y+ = 15` of 3 x 3 patches in local viscous units and set one
+    /// patch), acting for every target agent; the map is then the identity on one agent's spaces.
     pub fn onto(&self, target: &Spec, mapping: &MappingSpec) -> Result<(SpaceMap, ActorPolicy), TransferError> {
-        let map = resolve((&self.env_id, &self.spec.layout()), (target.id(), &target.layout()), mapping)?;
         let p = &self.policy;
+        if let (Some(ours), Some(theirs)) = (&p.agents, target.decomposition()) {
+            let local = |a: &hgym_agents::multi::Agents| (a.local_obs_dim(), a.local_act_dim());
+            if self.env_id != target.id() && local(ours) == local(&theirs) {
+                let (obs, act) = local(ours);
+                return Ok((SpaceMap::identity(obs, act), p.clone().with_agents(theirs)));
+            }
+        }
+        let map = resolve((&self.env_id, &self.spec.layout()), (target.id(), &target.layout()), mapping)?;
         if p.agents.is_some() {
             // A shared actor reads one agent's neighbourhood, not the whole flow: it moves only
             // onto the flow it was trained on.
@@ -176,4 +188,75 @@ pub fn load_mapping(path: &Path) -> Result<MappingSpec, TransferError> {
         .try_into()
         .map_err(|e: toml::de::Error| TransferError::Source(format!("{} [mapping]: {e}", path.display())))?;
     Ok(file.mapping)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::env::registry::lookup;
+    use hgym_agents::nn::{Activation, Init, Mlp};
+    use hgym_agents::policy::Policy;
+    use hgym_agents::rng::Rng;
+    use hgym_agents::Info;
+
+    /// A run of `env_id` holding `policy` (the folder is never read).
+    fn run(env_id: &str, policy: ActorPolicy) -> SourceRun {
+        let spec = lookup(env_id).unwrap();
+        SourceRun {
+            dir: PathBuf::from("source"),
+            policy,
+            env_id: env_id.into(),
+            spec_hash: spec.hash(),
+            algo: "td3".into(),
+            seed: 0,
+            level: "default".into(),
+            spec,
+        }
+    }
+
+    fn actor(obs: usize, act: usize) -> ActorPolicy {
+        let net = Mlp::new(
+            &[obs, 8, act],
+            Activation::Relu,
+            Activation::Tanh,
+            Init::FanIn,
+            Init::FanIn,
+            &mut Rng::seed(1),
+        );
+        ActorPolicy::new("td3", net, None, 10.0)
+    }
+
+    #[test]
+    fn a_channel_agents_actor_acts_for_every_patch_of_the_wing() {
+        let channel = lookup("TCFOpen_3D_Retau206").unwrap();
+        let agents = channel.decomposition().unwrap();
+        let src = run(
+            "TCFOpen_3D_Retau206",
+            actor(agents.local_obs_dim(), agents.local_act_dim()).with_agents(agents),
+        );
+        let wing = lookup("WingTBL_3D_Rec200000").unwrap();
+        let (map, mut p) = src.onto(&wing, &MappingSpec::default()).unwrap();
+        assert!(map.is_identity());
+        assert_eq!((p.obs_dim(), p.act_dim()), (wing.obs_dim(), wing.act_dim()));
+        // Each patch's action is the shared actor on that patch's neighbourhood.
+        let obs: Vec<f64> = (0..wing.obs_dim()).map(|k| ((k * 7919) % 13) as f64 / 13.0 - 0.5).collect();
+        let mut act = vec![0.0; wing.act_dim()];
+        p.act(&obs, &Info::default(), &mut act);
+        let theirs = wing.decomposition().unwrap();
+        let mut one = actor(18, 1);
+        let (mut local, mut a) = (vec![], vec![0.0]);
+        for agent in [0, 7, theirs.len() - 1] {
+            theirs.gather(agent, &obs, &mut local);
+            one.act(&local, &Info::default(), &mut a);
+            assert_eq!(act[theirs.act[agent][0]], a[0], "agent {agent}");
+        }
+    }
+
+    #[test]
+    fn a_single_agent_policy_does_not_move_onto_the_wing() {
+        let channel = lookup("TCFOpen_3D_Retau206").unwrap();
+        let src = run("TCFOpen_3D_Retau206", actor(channel.obs_dim(), channel.act_dim()));
+        let wing = lookup("WingTBL_3D_Rec200000").unwrap();
+        assert!(src.onto(&wing, &MappingSpec::default()).is_err());
+    }
 }
