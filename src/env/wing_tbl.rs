@@ -501,6 +501,8 @@ pub struct WingTblEnv {
     solver: Channel,
     layout: Layout,
     substeps: usize,
+    /// Time between actions.
+    interval: f64,
     /// Sensing row of each sensing column.
     sensing: Vec<usize>,
     tau_ref: f64,
@@ -548,13 +550,15 @@ impl WingTblEnv {
         };
         let convective = 0.5 / (1.3 / g.dx + 0.5 / g.dz);
         let dt = convective.min(0.8 * viscous_dt_limit(g, nu));
-        let substeps = (spec.control_interval() / dt).ceil().max(1.0) as usize;
+        // The spec's sizes and interval solve the panel flow each time: computed once here.
+        let interval = spec.control_interval();
+        let substeps = (interval / dt).ceil().max(1.0) as usize;
         let pspec = PlateSpec {
             n: spec.n(level),
             length: [g.lx, g.ly, g.lz],
             stretch: spec.stretch,
             nu,
-            dt: spec.control_interval() / substeps as f64,
+            dt: interval / substeps as f64,
             fringe,
             modes: spec.modes,
             trip: Some(trip),
@@ -583,6 +587,7 @@ impl WingTblEnv {
         let outflow: Vec<f64> = (0..wall_cells).map(|c| solver.v()[g.at_v(c % g.nx, g.ny, c / g.nx)]).collect();
         Ok(WingTblEnv {
             substeps,
+            interval,
             sensing,
             tau_ref,
             drag_ref,
@@ -707,11 +712,11 @@ impl WingTblEnv {
 
 impl Env for WingTblEnv {
     fn observation_space(&self) -> BoxSpace {
-        BoxSpace::uniform(self.spec.obs_dim(), -30.0, 30.0)
+        BoxSpace::uniform(2 * self.layout.columns() * self.layout.pz, -30.0, 30.0)
     }
 
     fn action_space(&self) -> BoxSpace {
-        BoxSpace::unit(self.spec.act_dim())
+        BoxSpace::unit(self.patch_tau.len())
     }
 
     fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
@@ -793,7 +798,7 @@ impl Env for WingTblEnv {
         self.actions += 1;
         let region_cells = (self.layout.px * self.layout.bx * self.layout.grid.nz) as f64;
         let mut info = Info::default();
-        info.set("t", self.actions as f64 * self.spec.control_interval());
+        info.set("t", self.actions as f64 * self.interval);
         info.set("clipped", clipped as f64);
         info.set("actuation_rms_plus", (rms / region_cells).sqrt() / self.layout.region_u_tau());
         info.set(
@@ -805,7 +810,7 @@ impl Env for WingTblEnv {
             info.set("diverged", 1.0);
             info.set_text("reason", reason);
             return Ok(StepResult {
-                obs: vec![0.0; self.spec.obs_dim()],
+                obs: vec![0.0; 2 * self.layout.columns() * self.layout.pz],
                 reward: 0.0,
                 terminated: true,
                 truncated: false,
@@ -929,7 +934,7 @@ pub fn calibrate(
     Ok(WingTblStatistics {
         spec_hash: spec.physics_hash(),
         level: level.name().into(),
-        time: actions.max(1) as f64 * env.spec.control_interval(),
+        time: actions.max(1) as f64 * env.interval,
         tau_w: stations.iter().map(|s| s.tau_w).collect(),
         ue: stations.iter().map(|s| s.ue).collect(),
         re_theta: stations.iter().map(|s| s.ue * s.theta / spec.nu()).collect(),
