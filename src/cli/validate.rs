@@ -251,20 +251,12 @@ fn run_tbl(args: &ValidateArgs) -> Result<Outcome> {
             args.level.name(), l.n[0], l.n[1], l.n[2], case.length[0], case.length[1], case.length[2], case.re_delta_star, l.dt, l.spin_up, l.average
         );
     }
-    let mut pb: Option<Progress> = None;
-    let r = pool
-        .install(|| {
-            plate::validate(args.level, &args.out, cache.as_deref(), &mut |done, total| {
-                pb.get_or_insert_with(|| Progress::new(total, "boundary layer")).set_position(done)
-            })
-        })
-        .map_err(|e| match e {
-            plate::PlateValidationError::Unrunnable(_) => anyhow::Error::new(UsageError(e.to_string())),
-            e => anyhow::Error::new(e).context("boundary-layer validation"),
-        })?;
-    if let Some(pb) = pb {
-        pb.finish_and_clear();
-    }
+    let r = with_progress(
+        &pool,
+        ("boundary layer", "boundary-layer validation"),
+        |p| plate::validate(args.level, &args.out, cache.as_deref(), p),
+        |e| matches!(e, plate::PlateValidationError::Unrunnable(_)),
+    )?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&r)?);
     } else {
@@ -285,6 +277,26 @@ fn run_tbl(args: &ValidateArgs) -> Result<Outcome> {
         println!("  results: {}", args.out.join("tbl_zpg.json").display());
     }
     Ok(if r.pass { Outcome::Ok } else { Outcome::CheckFailed })
+}
+
+/// Runs a finite-difference validation on `pool` behind a progress bar (`label`) of its solver
+/// steps; an error `unrunnable` says is the user's (the level cannot run: exit 2), any other one
+/// is reported under `context`.
+fn with_progress<R: Send, E: std::error::Error + Send + Sync + 'static>(
+    pool: &rayon::ThreadPool,
+    (label, context): (&str, &'static str),
+    run: impl FnOnce(&mut dyn FnMut(u64, u64)) -> Result<R, E> + Send,
+    unrunnable: impl Fn(&E) -> bool,
+) -> Result<R> {
+    let mut pb: Option<Progress> = None;
+    let r = pool.install(|| run(&mut |done, total| pb.get_or_insert_with(|| Progress::new(total, label)).set_position(done)));
+    if let Some(pb) = pb {
+        pb.finish_and_clear();
+    }
+    r.map_err(|e| match unrunnable(&e) {
+        true => UsageError(e.to_string()).into(),
+        false => anyhow::Error::new(e).context(context),
+    })
 }
 
 fn print_checks(checks: &[hgym::validate::channel::Check]) {
@@ -313,21 +325,12 @@ fn run_channel(args: &ValidateArgs) -> Result<Outcome> {
             args.level.name(), l.n[0], l.n[1], l.n[2], case.length[0], case.length[1], case.length[2], l.dt, l.spin_up, l.average
         );
     }
-    let mut pb: Option<Progress> = None;
-    let r = pool
-        .install(|| {
-            channel::validate(args.level, &args.out, cache.as_deref(), &mut |done, total| {
-                pb.get_or_insert_with(|| Progress::new(total, "channel Re_tau 180"))
-                    .set_position(done)
-            })
-        })
-        .map_err(|e| match e {
-            channel::ChannelValidationError::Unrunnable(_) => anyhow::Error::new(UsageError(e.to_string())),
-            e => anyhow::Error::new(e).context("channel validation"),
-        })?;
-    if let Some(pb) = pb {
-        pb.finish_and_clear();
-    }
+    let r = with_progress(
+        &pool,
+        ("channel Re_tau 180", "channel validation"),
+        |p| channel::validate(args.level, &args.out, cache.as_deref(), p),
+        |e| matches!(e, channel::ChannelValidationError::Unrunnable(_)),
+    )?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&r)?);
     } else {

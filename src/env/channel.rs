@@ -262,12 +262,9 @@ impl Family for Channels {
 }
 
 fn with_statistics(mut s: ChannelSpec) -> ChannelSpec {
-    if let Ok(table) = toml::from_str::<HashMap<String, ChannelStatistics>>(TABLE) {
-        if let Some(st) = table.get(&s.id) {
-            if st.spec_hash == s.physics_hash() {
-                s.statistics = st.clone();
-            }
-        }
+    let hash = s.physics_hash();
+    if let Some(st) = crate::report::table::committed(TABLE, &s.id, &hash, |st: &ChannelStatistics| &st.spec_hash) {
+        s.statistics = st;
     }
     s
 }
@@ -551,43 +548,23 @@ impl ChannelEnv {
     /// disturbed laminar flow.
     fn developed(&mut self) -> Result<Arc<State>, EnvError> {
         let key = format!("{}-{}", self.spec.physics_hash(), self.level.name());
-        if let Some(s) = developed().lock().ok().and_then(|m| m.get(&key).cloned()) {
-            return Ok(s);
-        }
         let n = self.spec.n(self.level);
-        let from_disk = self
-            .cache_file()
-            .and_then(|p| std::fs::read(p).ok())
-            .and_then(|b| bincode::deserialize::<State>(&b).ok())
-            .filter(|s| s.n == n);
-        let state = match from_disk {
-            Some(s) => s,
-            None => {
+        let file = self.cache_file();
+        super::spin_up::developed(
+            developed(),
+            key,
+            file,
+            |s: &State| s.n == n,
+            || {
                 let mut rng = hgym_agents::rng::Rng::seed(splitmix64(0x5eed));
                 self.solver.set_disturbed_laminar(0.3, || 2.0 * rng.uniform() - 1.0);
                 let steps = (self.spec.spin_up / self.solver.config().dt).round() as u64;
-                let id = self.spec.id.clone();
                 let solver = &mut self.solver;
-                super::spin_up::run_reported(&id, steps, |k| (0..k).try_for_each(|_| solver.step()))
+                super::spin_up::run_reported(&self.spec.id, steps, |k| (0..k).try_for_each(|_| solver.step()))
                     .map_err(|e| EnvError::Backend(format!("{}: spin-up failed: {e}", self.spec.id)))?;
-                let s = self.solver.state();
-                if let Some(p) = self.cache_file() {
-                    // A cache that cannot be written only costs the next process its spin-up.
-                    if let Some(dir) = p.parent() {
-                        let _ = std::fs::create_dir_all(dir);
-                    }
-                    if let Ok(bytes) = bincode::serialize(&s) {
-                        let _ = std::fs::write(&p, bytes);
-                    }
-                }
-                s
-            }
-        };
-        let state = Arc::new(state);
-        if let Ok(mut m) = developed().lock() {
-            m.insert(key, state.clone());
-        }
-        Ok(state)
+                Ok(self.solver.state())
+            },
+        )
     }
 
     /// Plane-mean-free `u` and `v` (cell centres) on the sensing row of `wall`, per wall cell.

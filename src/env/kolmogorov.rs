@@ -297,12 +297,9 @@ pub fn spec(re: u32) -> KolmogorovSpec {
         action_penalty: 0.1,
         statistics: FlowStatistics::default(),
     };
-    if let Ok(table) = toml::from_str::<HashMap<String, FlowStatistics>>(TABLE) {
-        if let Some(st) = table.get(&s.id) {
-            if st.spec_hash == s.physics_hash() {
-                s.statistics = st.clone();
-            }
-        }
+    let hash = s.physics_hash();
+    if let Some(st) = crate::report::table::committed(TABLE, &s.id, &hash, |st: &FlowStatistics| &st.spec_hash) {
+        s.statistics = st;
     }
     s
 }

@@ -1,13 +1,19 @@
 //! Telling someone how a spin-up is going, and keeping its result: the developed-flow state on
-//! disk ([`load_state`], [`store_state`]).
+//! disk ([`load_state`], [`store_state`]), or in the process and on disk ([`developed`]).
 //!
 //! The first reset of an ID runs the flow from rest onto its attractor before it is cached, which
 //! takes from seconds to about ten minutes (the cavity at its default level). The library draws
 //! nothing itself; a program installs one observer for the whole process (the `hgym` binary a
 //! progress bar), and every spin-up reports to it in up to [`REPORTS`] chunks.
 
+use std::collections::HashMap;
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::OnceLock;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use hgym_agents::EnvError;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
 
 /// One report: which spin-up (a serial number, distinct for spin-ups running at the same time),
 /// the environment ID, solver steps done, solver steps in all. `done == 0` opens a spin-up and
@@ -71,6 +77,47 @@ pub fn store_state(path: &std::path::Path, state: &[f32]) {
     if std::fs::write(&tmp, bytes).is_ok() {
         let _ = std::fs::rename(&tmp, path);
     }
+}
+
+/// A developed state shared by the process's environments through `memo` (under `key`) and kept
+/// on disk at `file` (bincode): the memo's, else the file's if it `fits`, else `spin_up()`'s,
+/// which then goes to both. A cache that cannot be written only costs the next process its
+/// spin-up.
+pub(crate) fn developed<T: Serialize + DeserializeOwned>(
+    memo: &Mutex<HashMap<String, Arc<T>>>,
+    key: String,
+    file: Option<PathBuf>,
+    fits: impl Fn(&T) -> bool,
+    spin_up: impl FnOnce() -> Result<T, EnvError>,
+) -> Result<Arc<T>, EnvError> {
+    if let Some(s) = memo.lock().ok().and_then(|m| m.get(&key).cloned()) {
+        return Ok(s);
+    }
+    let from_disk = file
+        .as_ref()
+        .and_then(|p| std::fs::read(p).ok())
+        .and_then(|b| bincode::deserialize::<T>(&b).ok())
+        .filter(&fits);
+    let state = match from_disk {
+        Some(s) => s,
+        None => {
+            let s = spin_up()?;
+            if let Some(p) = &file {
+                if let Some(dir) = p.parent() {
+                    let _ = std::fs::create_dir_all(dir);
+                }
+                if let Ok(bytes) = bincode::serialize(&s) {
+                    let _ = std::fs::write(p, bytes);
+                }
+            }
+            s
+        }
+    };
+    let state = Arc::new(state);
+    if let Ok(mut m) = memo.lock() {
+        m.insert(key, state.clone());
+    }
+    Ok(state)
 }
 
 #[cfg(test)]

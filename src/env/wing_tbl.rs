@@ -331,12 +331,9 @@ impl Family for WingTbls {
 }
 
 fn with_statistics(mut s: WingTblSpec) -> WingTblSpec {
-    if let Ok(table) = toml::from_str::<HashMap<String, WingTblStatistics>>(TABLE) {
-        if let Some(st) = table.get(&s.id) {
-            if st.spec_hash == s.physics_hash() {
-                s.statistics = st.clone();
-            }
-        }
+    let hash = s.physics_hash();
+    if let Some(st) = crate::report::table::committed(TABLE, &s.id, &hash, |st: &WingTblStatistics| &st.spec_hash) {
+        s.statistics = st;
     }
     s
 }
@@ -481,12 +478,9 @@ impl FamilySpec for WingTblSpec {
     }
 }
 
-/// A developed state and its clock (steps, time): the trip's forcing depends on the time.
-type Developed = (State, u64, f64);
-
 /// Developed states shared by every environment of the process, keyed by physics hash and level.
-fn developed() -> &'static Mutex<HashMap<String, Arc<Developed>>> {
-    static CACHE: OnceLock<Mutex<HashMap<String, Arc<Developed>>>> = OnceLock::new();
+fn developed() -> &'static Mutex<HashMap<String, Arc<State>>> {
+    static CACHE: OnceLock<Mutex<HashMap<String, Arc<State>>>> = OnceLock::new();
     CACHE.get_or_init(|| Mutex::new(HashMap::new()))
 }
 
@@ -624,43 +618,23 @@ impl WingTblEnv {
     }
 
     /// The developed flow: from the process cache, the disk cache, or spun up from the base flow.
-    fn developed(&mut self) -> Result<Arc<Developed>, EnvError> {
+    fn developed(&mut self) -> Result<Arc<State>, EnvError> {
         let key = format!("{}-{}", self.spec.physics_hash(), self.level.name());
-        if let Some(s) = developed().lock().ok().and_then(|m| m.get(&key).cloned()) {
-            return Ok(s);
-        }
         let n = self.spec.n(self.level);
-        let from_disk = self
-            .cache_file()
-            .and_then(|p| std::fs::read(p).ok())
-            .and_then(|b| bincode::deserialize::<Developed>(&b).ok())
-            .filter(|s| s.0.n == n);
-        let state = match from_disk {
-            Some(s) => s,
-            None => {
+        let file = self.cache_file();
+        super::spin_up::developed(
+            developed(),
+            key,
+            file,
+            |s: &State| s.n == n,
+            || {
                 let steps = (self.spec.spin_up / self.solver.config().dt).round() as u64;
-                let id = self.spec.id.clone();
                 let solver = &mut self.solver;
-                super::spin_up::run_reported(&id, steps, |k| (0..k).try_for_each(|_| solver.step()))
+                super::spin_up::run_reported(&self.spec.id, steps, |k| (0..k).try_for_each(|_| solver.step()))
                     .map_err(|e| EnvError::Backend(format!("{}: spin-up failed: {e}", self.spec.id)))?;
-                let s = (self.solver.state(), self.solver.steps(), self.solver.time());
-                if let Some(p) = self.cache_file() {
-                    // A cache that cannot be written only costs the next process its spin-up.
-                    if let Some(dir) = p.parent() {
-                        let _ = std::fs::create_dir_all(dir);
-                    }
-                    if let Ok(bytes) = bincode::serialize(&s) {
-                        let _ = std::fs::write(&p, bytes);
-                    }
-                }
-                s
-            }
-        };
-        let state = Arc::new(state);
-        if let Ok(mut m) = developed().lock() {
-            m.insert(key, state.clone());
-        }
-        Ok(state)
+                Ok(self.solver.state())
+            },
+        )
     }
 
     /// `u'` and `v'` (cell centres, spanwise means removed) at the sensing row of each sensing
@@ -722,8 +696,7 @@ impl Env for WingTblEnv {
     fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
         let state = self.developed()?;
         self.blowing.fill(0.0);
-        self.solver.restore(&state.0).map_err(backend)?;
-        self.solver.set_clock(state.1, state.2);
+        self.solver.restore(&state).map_err(backend)?;
         self.solver.set_transpiration(&self.blowing, &self.outflow).map_err(backend)?;
         // A seed-dependent start: 0-63 control intervals further on.
         let offset = (splitmix64(seed) % 64) as usize * self.substeps;

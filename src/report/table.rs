@@ -22,6 +22,14 @@ pub enum TableError {
     },
 }
 
+/// The committed row of `id` in the table `text`, if it was measured on the physics `hash` names
+/// (`hash_of` reads a row's; a row of other physics is stale and ignored, as is a table that does
+/// not parse).
+pub fn committed<T: DeserializeOwned>(text: &str, id: &str, hash: &str, hash_of: impl Fn(&T) -> &str) -> Option<T> {
+    let mut rows: BTreeMap<String, T> = toml::from_str(text).ok()?;
+    rows.remove(id).filter(|row| hash_of(row) == hash)
+}
+
 /// The rows of the TOML table `text` (read from `path`, for the error).
 pub fn parse<T: DeserializeOwned>(text: &str, path: &Path) -> Result<BTreeMap<String, T>, TableError> {
     toml::from_str(text).map_err(|e| TableError::Malformed {

@@ -154,13 +154,40 @@ pub struct ChannelValidation {
     pub manifest: crate::report::manifest::Manifest,
 }
 
-fn cache_path(dir: &Path, c: &Case, level: Level) -> PathBuf {
+/// Where a case's developed state at `level` is cached: the name changes with the case file's
+/// text (`case_text`) and the solver's version, so an edit of either starts a new spin-up.
+pub(crate) fn cache_path(dir: &Path, case_text: &str, case: &str, level: Level, solver_version: &str) -> PathBuf {
     let mut h = Sha256::new();
-    h.update(CASE.as_bytes());
+    h.update(case_text.as_bytes());
     h.update(level.name().as_bytes());
-    h.update(SOLVER_VERSION.as_bytes());
+    h.update(solver_version.as_bytes());
     let hex: String = h.finalize().iter().take(8).map(|b| format!("{b:02x}")).collect();
-    dir.join(format!("{}-{}-{hex}.bin", c.case, level.name()))
+    dir.join(format!("{case}-{}-{hex}.bin", level.name()))
+}
+
+/// Restores the state cached at `path` into `ch` if there is one of its size (`true`).
+pub(crate) fn restore_cached(ch: &mut Channel, path: Option<&Path>) -> Result<bool, ChannelError> {
+    let cached = path
+        .and_then(|p| std::fs::read(p).ok())
+        .and_then(|b| bincode::deserialize::<ChannelState>(&b).ok())
+        .filter(|s| s.n == ch.config().n);
+    match cached {
+        Some(s) => ch.restore(&s).map(|_| true),
+        None => Ok(false),
+    }
+}
+
+/// Caches the state of `ch` at `path`; a cache that cannot be written only costs the next run
+/// its spin-up.
+pub(crate) fn store(ch: &Channel, path: Option<&Path>) {
+    if let Some(p) = path {
+        if let Some(dir) = p.parent() {
+            let _ = std::fs::create_dir_all(dir);
+        }
+        if let Ok(bytes) = bincode::serialize(&ch.state()) {
+            let _ = std::fs::write(p, bytes);
+        }
+    }
 }
 
 /// `(x, y)` table columns `cx`, `cy` of a CSV with `#` comment lines and a header.
@@ -231,15 +258,8 @@ pub fn validate(
         )));
     }
     let steps_of = |t: f64| (t / l.dt).round() as u64;
-    let mut cached = false;
-    if let Some(state) = cache.map(|d| cache_path(d, &c, level)).and_then(|p| std::fs::read(&p).ok()) {
-        if let Ok(s) = bincode::deserialize::<ChannelState>(&state) {
-            if s.n == l.n {
-                ch.restore(&s)?;
-                cached = true;
-            }
-        }
-    }
+    let path = cache.map(|d| cache_path(d, CASE, &c.case, level, SOLVER_VERSION));
+    let cached = restore_cached(&mut ch, path.as_deref())?;
     let total = steps_of(l.average) + if cached { 0 } else { steps_of(l.spin_up) };
     if !cached {
         let mut rng = Rng::seed(c.seed);
@@ -248,15 +268,7 @@ pub fn validate(
             ch.step()?;
             progress(ch.steps(), total);
         }
-        if let Some(dir) = cache {
-            let path = cache_path(dir, &c, level);
-            let state = ch.state();
-            // A cache that cannot be written only costs the next run its spin-up.
-            let _ = std::fs::create_dir_all(dir);
-            if let Ok(bytes) = bincode::serialize(&state) {
-                let _ = std::fs::write(&path, bytes);
-            }
-        }
+        store(&ch, path.as_deref());
     }
     let s0 = total - steps_of(l.average);
     let every = (l.sample_interval / l.dt).round().max(1.0) as u64;

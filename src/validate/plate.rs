@@ -15,20 +15,19 @@
 //! `benchmarks/validation/data/tbl_zpg_schlatter_orlu_2010.csv`. The developed state is cached
 //! as the channel's is. Writes `<out>/tbl_zpg.json` and `<out>/tbl_zpg/{c_f,h12}.png`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
 use thiserror::Error;
 
-use super::channel::{columns, Check};
+use super::channel::{cache_path, columns, restore_cached, store, Check, LevelSpec};
 use crate::flow::level::PerLevel;
 use crate::flow::Level;
 use crate::report::plots;
 use hgym_solvers::bl_integral::develop;
 use hgym_solvers::blasius::Blasius;
 use hgym_solvers::channel::plate::{layer_shape, plate, PlateSpec};
-use hgym_solvers::channel::{viscous_dt_limit, ChannelError, ChannelState, FringeSpec, Grid, LayerSums, Top, TripSpec};
+use hgym_solvers::channel::{viscous_dt_limit, ChannelError, FringeSpec, Grid, LayerSums, Top, TripSpec};
 
 /// The committed case file.
 pub const CASE: &str = include_str!("../../benchmarks/validation/tbl_zpg.toml");
@@ -46,16 +45,6 @@ pub enum PlateValidationError {
     Solver(#[from] ChannelError),
     #[error("{path}: {message}")]
     Output { path: String, message: String },
-}
-
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct LevelSpec {
-    pub n: [usize; 3],
-    pub dt: f64,
-    pub spin_up: f64,
-    pub average: f64,
-    pub sample_interval: f64,
 }
 
 /// The fringe: the last `length` of the box; `rise` and `fall` are fractions of it.
@@ -169,15 +158,6 @@ pub struct PlateValidation {
     pub manifest: crate::report::manifest::Manifest,
 }
 
-fn cache_path(dir: &Path, c: &Case, level: Level) -> PathBuf {
-    let mut h = Sha256::new();
-    h.update(CASE.as_bytes());
-    h.update(level.name().as_bytes());
-    h.update(SOLVER_VERSION.as_bytes());
-    let hex: String = h.finalize().iter().take(8).map(|b| format!("{b:02x}")).collect();
-    dir.join(format!("{}-{}-{hex}.bin", c.case, level.name()))
-}
-
 /// Least-squares line through `(x, y)`, evaluated at `x0` (`None` for fewer than two points).
 fn line_at(xs: &[f64], ys: &[f64], x0: f64) -> Option<f64> {
     let n = xs.len() as f64;
@@ -256,28 +236,15 @@ pub fn validate(
     let b = Blasius::solve();
     let (mut ch, _) = plate(&spec, |_| 1.0, base_shape(&c, &b))?;
     let steps_of = |t: f64| (t / l.dt).round() as u64;
-    let mut cached = false;
-    if let Some(state) = cache.map(|d| cache_path(d, &c, level)).and_then(|p| std::fs::read(&p).ok()) {
-        if let Ok(s) = bincode::deserialize::<ChannelState>(&state) {
-            if s.n == l.n {
-                ch.restore(&s)?;
-                cached = true;
-            }
-        }
-    }
+    let path = cache.map(|d| cache_path(d, CASE, &c.case, level, SOLVER_VERSION));
+    let cached = restore_cached(&mut ch, path.as_deref())?;
     let total = steps_of(l.average) + if cached { 0 } else { steps_of(l.spin_up) };
     if !cached {
         for _ in 0..steps_of(l.spin_up) {
             ch.step()?;
             progress(ch.steps(), total);
         }
-        if let Some(dir) = cache {
-            // A cache that cannot be written only costs the next run its spin-up.
-            let _ = std::fs::create_dir_all(dir);
-            if let Ok(bytes) = bincode::serialize(&ch.state()) {
-                let _ = std::fs::write(cache_path(dir, &c, level), bytes);
-            }
-        }
+        store(&ch, path.as_deref());
     }
     let s0 = total - steps_of(l.average);
     let every = (l.sample_interval / l.dt).round().max(1.0) as u64;

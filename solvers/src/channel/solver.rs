@@ -71,13 +71,16 @@ fn damped_dt_limit(g: &Grid, nu: f64, damping: f64) -> f64 {
     0.9 * 2.51 / lam
 }
 
-/// A velocity field of a channel with its grid size (for caching developed flows).
+/// A velocity field of a channel with its grid size and its clock (for caching developed flows:
+/// a trip's forcing depends on the time).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ChannelState {
     pub n: [usize; 3],
     pub u: Vec<f64>,
     pub v: Vec<f64>,
     pub w: Vec<f64>,
+    pub steps: u64,
+    pub time: f64,
 }
 
 pub struct Channel {
@@ -156,11 +159,6 @@ impl Channel {
     pub fn steps(&self) -> u64 {
         self.step
     }
-    /// Sets the clock (a restored state's time: the trip's forcing depends on it).
-    pub fn set_clock(&mut self, steps: u64, time: f64) {
-        self.step = steps;
-        self.time = time;
-    }
     /// `u` on the x-faces, `at(i, j, k)` order.
     pub fn u(&self) -> &[f64] {
         &self.u
@@ -219,19 +217,21 @@ impl Channel {
         du
     }
 
-    /// The current velocity field.
+    /// The current velocity field and clock.
     pub fn state(&self) -> ChannelState {
         ChannelState {
             n: self.cfg.n,
             u: self.u.clone(),
             v: self.v.clone(),
             w: self.w.clone(),
+            steps: self.step,
+            time: self.time,
         }
     }
 
-    /// Replaces the velocity, wall rows included, by a state of [`Channel::state`] bit for bit
-    /// (it is divergence-free already), so a run continued from a cached state is the run that
-    /// cached it.
+    /// Replaces the velocity, wall rows included, and the clock by a state of
+    /// [`Channel::state`] bit for bit (it is divergence-free already), so a run continued from a
+    /// cached state is the run that cached it.
     pub fn restore(&mut self, s: &ChannelState) -> Result<(), ChannelError> {
         let fits = s.n == self.cfg.n && s.u.len() == self.u.len() && s.v.len() == self.v.len() && s.w.len() == self.w.len();
         if !fits {
@@ -243,6 +243,8 @@ impl Channel {
         self.u.copy_from_slice(&s.u);
         self.v.copy_from_slice(&s.v);
         self.w.copy_from_slice(&s.w);
+        self.step = s.steps;
+        self.time = s.time;
         Ok(())
     }
 
