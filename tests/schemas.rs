@@ -19,6 +19,8 @@ fn schema_file(path: &Path, v: &serde_json::Value) -> Option<&'static str> {
         Some("hgym/seeds/v1") => Some("seeds.schema.json"),
         Some("hgym/comparison/v1") => Some("comparison.schema.json"),
         Some("hgym/transfer/v1") => Some("transfer.schema.json"),
+        Some("hgym/transfer-deployment/v1") => Some("transfer-deployment.schema.json"),
+        Some("hgym/deployment-arm/v1") => Some("deployment-arm.schema.json"),
         Some("hgym/rollout/v1") => Some("rollout.schema.json"),
         Some("hgym/leaderboard/v1") => Some("leaderboard.schema.json"),
         Some("hgym/hf-export/v1") => Some("hf-export.schema.json"),

@@ -173,10 +173,22 @@ fn zero_shot_fine_tuning_and_a_protocol_from_the_cylinder_to_the_square() {
 
 #[test]
 fn unknown_pairs_and_missing_sources_exit_2_saying_what_to_run() {
-    let o = hgym(&["transfer", "channel", "naca0012"]);
+    let o = hgym(&["transfer", "channel", "cylinder"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o).contains("Cylinder_2D_Re200 Cylinder_2D_Re1000"), "{}", text(&o));
     let tmp = tempfile::tempdir().unwrap();
+    // The channel -> wing protocol without its channel runs: the command that trains them.
+    let o = Command::new(env!("CARGO_BIN_EXE_hgym"))
+        .args(["transfer", "channel", "naca0012", "--out", "."])
+        .current_dir(tmp.path())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o).contains("hgym train --env TCFOpen_3D_Retau206 --algo td3 --res coarse --seeds 0,1,2"),
+        "{}",
+        text(&o)
+    );
     // From an empty folder: the protocol's relative source paths name nothing there (in the
     // repository they name the committed Re 1000 runs, and the protocol would start training).
     let o = Command::new(env!("CARGO_BIN_EXE_hgym"))
@@ -202,4 +214,62 @@ fn unknown_pairs_and_missing_sources_exit_2_saying_what_to_run() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o).contains("holds no finished training run"), "{}", text(&o));
+}
+
+/// A zero-shot deployment protocol end to end on a tiny wing: the committed minimal-channel MARL
+/// run (its shared actor sees 3 x 3 patches of u', v' and sets one, as the wing's agents do)
+/// beside the uncontrolled flow, opposition control and net blowing; a second call reruns nothing.
+#[test]
+fn a_deployment_protocol_runs_every_arm_and_compares_them() {
+    let tmp = tempfile::tempdir().unwrap();
+    let pfile = tmp.path().join("wing.toml");
+    let protocol = r#"
+name = "mini_wing"
+description = "test"
+source = "TCFMini_3D_Retau180"
+target = "WingTBL_3D_Rec200000"
+algo = "td3"
+level = "coarse"
+seeds = [0]
+source_spec_hash = "23584c5aa36fc9675cf26cd72b2a2765426e94939f81069586fb297caf193118"
+source_runs = "results/train/TCFMini_3D_Retau180-td3-default/seed{seed}"
+fraction = 0.9
+[deployment]
+episodes = 2
+settle_actions = 2
+env = { grid = { coarse = [96, 32, 8], default = [96, 32, 8], fine = [96, 32, 8] }, patch_cells = { coarse = [6, 2], default = [6, 2], fine = [6, 2] }, spin_up = 0.002, stretch = 3.2, episode_actions = 5 }
+baselines = [
+    { name = "opposition", policy = "wall-opposition" },
+    { name = "blowing", policy = "constant=0.5", env = { zero_net_flux = false } },
+]
+"#;
+    std::fs::write(&pfile, protocol).unwrap();
+    let args = [
+        "transfer",
+        "--protocol",
+        pfile.to_str().unwrap(),
+        "--out",
+        tmp.path().to_str().unwrap(),
+    ];
+    let o = hgym(&args);
+    assert!(o.status.success(), "{}", text(&o));
+    let root = tmp.path().join("mini_wing");
+    let cmp = json(&root.join("comparison.json"));
+    assert_eq!(cmp["schema"], "hgym/transfer-deployment/v1");
+    let arms: Vec<&str> = cmp["arms"].as_array().unwrap().iter().map(|a| a["arm"].as_str().unwrap()).collect();
+    assert_eq!(arms, ["uncontrolled", "zeroshot", "opposition", "blowing"]);
+    assert_eq!(cmp["arms"][0]["local_friction_reduction_pct"]["mean"], 0.0);
+    for dir in ["uncontrolled", "zeroshot/seed0", "opposition", "blowing"] {
+        let rec = json(&root.join(dir).join("deployment.json"));
+        assert_eq!(rec["episodes"].as_array().unwrap().len(), 2, "{dir}");
+        assert!(rec["cpu_s_per_episode"].as_f64().unwrap() > 0.0, "{dir}");
+        assert!(root.join(dir).join("tau_w.png").exists() && root.join(dir).join("metrics.json").exists());
+    }
+    // Net blowing thickens the layer: less friction under it than without.
+    let blowing = json(&root.join("blowing/deployment.json"));
+    assert!(blowing["local_friction_reduction_pct"]["mean"].as_f64().unwrap() > 0.0, "{blowing}");
+    assert!(cmp["cost"]["target_core_hours_per_episode"].as_f64().unwrap() > 0.0);
+    assert!(root.join("friction.png").exists() && root.join("reductions.png").exists());
+    let o = hgym(&args);
+    assert!(o.status.success() && text(&o).matches("done already").count() == 4, "{}", text(&o));
 }

@@ -4,6 +4,7 @@
 
 pub mod bench;
 pub mod data;
+pub mod deployment;
 pub mod envs;
 pub mod out;
 pub mod plot;

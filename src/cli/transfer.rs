@@ -101,6 +101,10 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
         sources.push(src);
     }
     let (pool, threads) = thread_pool(args.threads)?;
+    if let Some(d) = &p.deployment {
+        // Ctrl-C ends a deployment at once: the arms on disk are whole, the one in progress reruns.
+        return crate::cli::deployment::run(&p, d, &sources, &target, &root, &pool, threads, args.analyse_only, args.json);
+    }
     install_interrupt();
     if !args.analyse_only {
         let total = ARMS.len() * p.seeds.len();
@@ -143,7 +147,7 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
         }
     }
     let r0 = pool.install(|| hgym::train::compare::uncontrolled_return(&p.target, p.level, &p.config))?;
-    let cmp = hgym::transfer::compare::analyse(&p, &root, r0, episode_actions(&target)?)?;
+    let cmp = hgym::transfer::compare::analyse(&p, &root, r0, crate::cli::deployment::episode_actions(&target)? as usize)?;
     std::fs::write(root.join("comparison.json"), serde_json::to_string_pretty(&cmp)? + "\n")?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&cmp)?);
@@ -198,14 +202,6 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
     }
     println!("  results: {}", root.display());
     Ok(Outcome::Ok)
-}
-
-/// Episode length in actions, from the spec.
-fn episode_actions(spec: &hgym::env::Spec) -> Result<usize> {
-    spec.to_json()?["episode_actions"]
-        .as_u64()
-        .map(|n| n as usize)
-        .with_context(|| format!("{} has no episode_actions", spec.id()))
 }
 
 /// The zero-shot arm of one seed: the source policy, mapped, on the target's final evaluation

@@ -111,6 +111,28 @@ pub struct WingTblSpec {
     pub statistics: WingTblStatistics,
 }
 
+/// The paper's LES of the wing: the chord average of `Re_theta` over the control region (its SI).
+pub const PAPER_MEAN_RE_THETA: f64 = 382.0;
+
+/// The uncontrolled layer a level measured (`hgym envs calibrate`) against the integral estimate
+/// it is built to match, at the control region's `u` positions.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct TargetCheck {
+    pub level: String,
+    pub xc: Vec<f64>,
+    pub u_tau: Vec<f64>,
+    pub u_tau_estimate: Vec<f64>,
+    pub re_theta: Vec<f64>,
+    pub re_theta_estimate: Vec<f64>,
+    /// Means over the region.
+    pub mean_u_tau: f64,
+    pub mean_u_tau_estimate: f64,
+    pub mean_re_theta: f64,
+    pub mean_re_theta_estimate: f64,
+    /// [`PAPER_MEAN_RE_THETA`].
+    pub mean_re_theta_paper: f64,
+}
+
 /// The wing's layer laid flat, with what a level makes of it.
 struct Layout {
     plate: WingPlate,
@@ -228,6 +250,36 @@ impl WingTblSpec {
 
     fn calibrated_at(&self, level: Level, stations: usize) -> bool {
         self.statistics.level == level.name() && self.statistics.tau_w.len() == stations
+    }
+
+    /// The calibrated layer at `level` against the integral estimate (`None` until calibrated there).
+    pub fn target_check(&self, level: Level) -> Result<Option<TargetCheck>, String> {
+        let l = self.layout(level)?;
+        if !self.calibrated_at(level, l.u_tau.len()) {
+            return Ok(None);
+        }
+        let cols: Vec<usize> = (l.i0..l.i0 + l.px * l.bx).collect();
+        let x = |i: usize| i as f64 * l.grid.dx;
+        let est = |i: usize| l.plate.station(x(i));
+        let nu = self.nu();
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+        let u_tau: Vec<f64> = cols.iter().map(|&i| l.u_tau[i]).collect();
+        let u_tau_estimate: Vec<f64> = cols.iter().map(|&i| est(i).u_tau()).collect();
+        let re_theta: Vec<f64> = cols.iter().map(|&i| self.statistics.re_theta[i]).collect();
+        let re_theta_estimate: Vec<f64> = cols.iter().map(|&i| est(i).ue * est(i).theta / nu).collect();
+        Ok(Some(TargetCheck {
+            level: level.name().into(),
+            xc: cols.iter().map(|&i| l.plate.xc_of(x(i))).collect(),
+            mean_u_tau: mean(&u_tau),
+            mean_u_tau_estimate: mean(&u_tau_estimate),
+            mean_re_theta: mean(&re_theta),
+            mean_re_theta_estimate: mean(&re_theta_estimate),
+            mean_re_theta_paper: PAPER_MEAN_RE_THETA,
+            u_tau,
+            u_tau_estimate,
+            re_theta,
+            re_theta_estimate,
+        }))
     }
 
     /// The checks a spec must pass before it builds an environment; the message names the field.
@@ -939,6 +991,26 @@ mod tests {
         s.stretch = 3.2;
         s.zero_net_flux = zero_net_flux;
         WingTblEnv::new(s, Level::Coarse, None).unwrap()
+    }
+
+    /// The check reads the calibrated level's table over the control region, and exists only
+    /// where a level is calibrated.
+    #[test]
+    fn the_target_check_covers_the_control_region_of_the_calibrated_level() {
+        let s = target();
+        assert_eq!(s.target_check(Level::Default).unwrap(), None);
+        let Some(t) = s.target_check(Level::Coarse).unwrap() else {
+            panic!("the coarse level is calibrated (benchmarks/envs/wing_tbl.toml)")
+        };
+        let n = t.xc.len();
+        assert!(n > 10 && [t.u_tau.len(), t.u_tau_estimate.len(), t.re_theta.len(), t.re_theta_estimate.len()] == [n; 4]);
+        assert!((t.xc[0] - 0.25).abs() < 0.01 && (t.xc[n - 1] - 0.86).abs() < 0.03, "{:?}", t.xc);
+        let l = s.layout(Level::Coarse).unwrap();
+        assert_eq!(t.u_tau[0], s.statistics.tau_w[l.i0].sqrt());
+        assert!(
+            t.re_theta_estimate.windows(2).all(|w| w[1] > w[0]),
+            "the layer grows along the region"
+        );
     }
 
     #[test]

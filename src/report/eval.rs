@@ -126,3 +126,25 @@ pub struct EvalReport {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lift_deviation: Option<LiftDeviationStat>,
 }
+
+impl EvalReport {
+    /// The statistics over `episodes` of one policy on one environment.
+    pub fn of(episodes: Vec<EvalEpisode>, policy: &str, env_id: &str, spec_hash: &str, level: &str) -> EvalReport {
+        let col = |f: fn(&EvalEpisode) -> f64| Stat::of(&episodes.iter().map(f).collect::<Vec<_>>());
+        EvalReport {
+            schema: "hgym/eval/v1".into(),
+            env_id: env_id.into(),
+            spec_hash: spec_hash.into(),
+            level: level.into(),
+            policy: policy.into(),
+            ret: col(|e| e.ret),
+            mean_c_d: col(|e| e.mean_c_d),
+            uncontrolled_c_d: col(|e| e.uncontrolled_c_d),
+            drag_reduction_pct: col(|e| e.drag_reduction_pct),
+            mean_abs_c_l: col(|e| e.mean_abs_c_l),
+            actuation_cost: col(|e| e.actuation_cost),
+            lift_deviation: LiftDeviationStat::of(&episodes),
+            episodes,
+        }
+    }
+}

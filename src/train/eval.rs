@@ -10,7 +10,7 @@ use hgym_agents::policy::{ActorPolicy, Policy};
 use hgym_agents::rollout::{episode, EpisodeAccumulator, EpisodeStats};
 
 use crate::data::trajectory::TrajectoryWriter;
-use hgym_agents::{Env, EnvError};
+use hgym_agents::{Env, EnvError, StepResult};
 
 pub use crate::report::eval::{nan_if_null, EvalEpisode, EvalReport, LiftDeviation, LiftDeviationStat, Stat};
 
@@ -60,76 +60,78 @@ pub fn evaluate<E: Env + crate::env::fields::FlowFields + ?Sized>(
     progress: &mut dyn FnMut(usize),
 ) -> Result<EvalReport, EnvError> {
     let mut episodes = vec![];
-    let io = |e: crate::data::DataError| EnvError::Backend(crate::report::chain(&e));
     for (k, (seed, uncontrolled)) in seeds.iter().zip(reference).enumerate() {
-        let mut cost = 0.0;
-        let (mut obs, mut info) = env.reset(*seed)?;
-        if let Some(t) = trajectory.as_deref_mut() {
-            t.reset(&obs, &info).map_err(io)?;
-            if t.wants_field() {
-                t.field(env.snapshot()).map_err(io)?;
-            }
-        }
-        policy.reset();
-        let mut action = vec![0.0; env.action_space().dim()];
-        let mut acc = EpisodeAccumulator::default();
-        loop {
-            policy.act(&obs, &info, &mut action);
-            let r = env.step(&action)?;
-            cost += action.iter().map(|v| v * v).sum::<f64>();
-            if let Some(t) = trajectory.as_deref_mut() {
-                t.step_with_field(&action, &r, Some(|| env.snapshot())).map_err(io)?;
-            }
-            acc.add(&r);
-            let done = r.terminated || r.truncated;
-            obs = r.obs;
-            info = r.info;
-            if done {
-                break;
-            }
-        }
-        let stats: EpisodeStats = acc.finish();
-        let mean_c_d = stats.info_means.get("C_D").copied().unwrap_or(f64::NAN);
-        let c_d0 = uncontrolled.c_d;
-        let lift_deviation = stats
-            .info_means
-            .get("abs_dC_L")
-            .zip(uncontrolled.abs_dc_l)
-            .map(|(&d, d0)| LiftDeviation {
-                mean_abs_dc_l: d,
-                uncontrolled_abs_dc_l: d0,
-                reduction_pct: 100.0 * (1.0 - d / d0),
-            });
-        episodes.push(EvalEpisode {
-            seed: *seed,
-            ret: stats.ret,
-            length: stats.length,
-            terminated: stats.terminated,
-            mean_c_d,
-            uncontrolled_c_d: c_d0,
-            drag_reduction_pct: 100.0 * (1.0 - mean_c_d / c_d0),
-            mean_abs_c_l: stats.info_means.get("abs_C_L").copied().unwrap_or(f64::NAN),
-            actuation_cost: cost / stats.length.max(1) as f64,
-            lift_deviation,
-        });
+        let (e, _) = eval_episode(env, policy, *seed, uncontrolled, trajectory.as_deref_mut(), &mut |_, _| {})?;
+        episodes.push(e);
         progress(k + 1);
     }
-    let col = |f: fn(&EvalEpisode) -> f64| Stat::of(&episodes.iter().map(f).collect::<Vec<_>>());
-    Ok(EvalReport {
-        schema: "hgym/eval/v1".into(),
-        env_id: env_id.into(),
-        spec_hash: spec_hash.into(),
-        level: level.into(),
-        policy: policy_name.into(),
-        ret: col(|e| e.ret),
-        mean_c_d: col(|e| e.mean_c_d),
-        uncontrolled_c_d: col(|e| e.uncontrolled_c_d),
-        drag_reduction_pct: col(|e| e.drag_reduction_pct),
-        mean_abs_c_l: col(|e| e.mean_abs_c_l),
-        actuation_cost: col(|e| e.actuation_cost),
-        lift_deviation: LiftDeviationStat::of(&episodes),
-        episodes,
-    })
+    Ok(EvalReport::of(episodes, policy_name, env_id, spec_hash, level))
+}
+
+/// One evaluation episode from `reset(seed)` against the uncontrolled flow from the same state;
+/// `on_step` sees the environment and the step's result after every step (to accumulate fields
+/// or figures of its own). Also returns the episode's statistics (the means of every info key).
+pub fn eval_episode<E: Env + crate::env::fields::FlowFields + ?Sized>(
+    env: &mut E,
+    policy: &mut dyn Policy,
+    seed: u64,
+    uncontrolled: &Uncontrolled,
+    mut trajectory: Option<&mut TrajectoryWriter>,
+    on_step: &mut dyn FnMut(&mut E, &StepResult),
+) -> Result<(EvalEpisode, EpisodeStats), EnvError> {
+    let io = |e: crate::data::DataError| EnvError::Backend(crate::report::chain(&e));
+    let mut cost = 0.0;
+    let (mut obs, mut info) = env.reset(seed)?;
+    if let Some(t) = trajectory.as_deref_mut() {
+        t.reset(&obs, &info).map_err(io)?;
+        if t.wants_field() {
+            t.field(env.snapshot()).map_err(io)?;
+        }
+    }
+    policy.reset();
+    let mut action = vec![0.0; env.action_space().dim()];
+    let mut acc = EpisodeAccumulator::default();
+    loop {
+        policy.act(&obs, &info, &mut action);
+        let r = env.step(&action)?;
+        cost += action.iter().map(|v| v * v).sum::<f64>();
+        if let Some(t) = trajectory.as_deref_mut() {
+            t.step_with_field(&action, &r, Some(|| env.snapshot())).map_err(io)?;
+        }
+        on_step(env, &r);
+        acc.add(&r);
+        let done = r.terminated || r.truncated;
+        obs = r.obs;
+        info = r.info;
+        if done {
+            break;
+        }
+    }
+    let stats: EpisodeStats = acc.finish();
+    let mean_c_d = stats.info_means.get("C_D").copied().unwrap_or(f64::NAN);
+    let c_d0 = uncontrolled.c_d;
+    let lift_deviation = stats
+        .info_means
+        .get("abs_dC_L")
+        .zip(uncontrolled.abs_dc_l)
+        .map(|(&d, d0)| LiftDeviation {
+            mean_abs_dc_l: d,
+            uncontrolled_abs_dc_l: d0,
+            reduction_pct: 100.0 * (1.0 - d / d0),
+        });
+    let episode = EvalEpisode {
+        seed,
+        ret: stats.ret,
+        length: stats.length,
+        terminated: stats.terminated,
+        mean_c_d,
+        uncontrolled_c_d: c_d0,
+        drag_reduction_pct: 100.0 * (1.0 - mean_c_d / c_d0),
+        mean_abs_c_l: stats.info_means.get("abs_C_L").copied().unwrap_or(f64::NAN),
+        actuation_cost: cost / stats.length.max(1) as f64,
+        lift_deviation,
+    };
+    Ok((episode, stats))
 }
 
 /// A policy named on the command line: a trained-run folder (its `policy.json`), or a

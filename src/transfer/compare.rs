@@ -88,7 +88,7 @@ fn read(path: &Path) -> Result<String, CompareError> {
     })
 }
 
-fn json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, CompareError> {
+pub(crate) fn json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, CompareError> {
     serde_json::from_str(&read(path)?).map_err(|e| CompareError::Invalid {
         path: path.to_path_buf(),
         message: e.to_string(),
@@ -97,7 +97,7 @@ fn json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, CompareError> 
 
 /// Wall time, core-hours and whether those were measured as CPU time, from a result folder's
 /// `manifest.json` (train or eval).
-fn cost(dir: &Path) -> Result<(f64, f64, bool), CompareError> {
+pub(crate) fn cost(dir: &Path) -> Result<(f64, f64, bool), CompareError> {
     let m: serde_json::Value = json(&dir.join("manifest.json"))?;
     let wall = m["manifest"]["wall_time_s"].as_f64().unwrap_or(f64::NAN);
     let threads = m["manifest"]["threads"].as_f64().unwrap_or(f64::NAN);

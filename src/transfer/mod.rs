@@ -13,8 +13,10 @@
 //! act through the same network.
 
 pub mod compare;
+pub mod deploy;
 pub mod mapping;
 pub mod protocol;
+pub mod summary;
 
 use std::path::{Path, PathBuf};
 

@@ -30,6 +30,10 @@ pub const BUNDLED: &[(&str, &str)] = &[
         "cylinder_2d_3d_re200",
         include_str!("../../benchmarks/protocols/transfer/cylinder_2d_3d_re200.toml"),
     ),
+    (
+        "channel_wing",
+        include_str!("../../benchmarks/protocols/transfer/channel_wing.toml"),
+    ),
 ];
 
 /// The three arms, in the order they run.
@@ -67,6 +71,40 @@ pub struct Protocol {
     /// Training configuration of the source runs and of both training arms.
     #[serde(default)]
     pub config: TrainConfig,
+    /// A zero-shot deployment protocol: no training on the target, only the source policies
+    /// deployed beside the uncontrolled flow and classical controllers ([`super::deploy`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deployment: Option<Deployment>,
+}
+
+/// The `[deployment]` table of a zero-shot protocol.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Deployment {
+    /// Evaluation episodes (seeds `config.train.eval_seed` on) of every arm.
+    pub episodes: u64,
+    /// Actions of each episode before the measurement starts (the controlled layer's transient).
+    #[serde(default)]
+    pub settle_actions: usize,
+    /// `[env]` overrides of the target for every arm (a baseline's own on top).
+    #[serde(default, skip_serializing_if = "toml::Table::is_empty")]
+    pub env: toml::Table,
+    /// Classical controllers deployed the same way.
+    #[serde(default)]
+    pub baselines: Vec<BaselineArm>,
+}
+
+/// A classical controller of a deployment protocol: an `hgym eval --policy` baseline, with
+/// `[env]` overrides of the target (e.g. net blowing through the wall).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BaselineArm {
+    /// Folder name and label, e.g. `opposition`.
+    pub name: String,
+    /// e.g. `wall-opposition`, `constant=0.02`.
+    pub policy: String,
+    #[serde(default, skip_serializing_if = "toml::Table::is_empty")]
+    pub env: toml::Table,
 }
 
 /// A protocol file that cannot be used, or a pair without one (bad input).
@@ -99,6 +137,20 @@ impl Protocol {
         }
         if !(p.fraction > 0.0 && p.fraction <= 1.0) {
             return Err(invalid(format!("fraction must be in (0, 1], got {}", p.fraction)));
+        }
+        if let Some(d) = &p.deployment {
+            if d.episodes == 0 {
+                return Err(invalid("[deployment] episodes must be at least 1".into()));
+            }
+            for b in &d.baselines {
+                crate::train::eval::parse_policy(&b.policy).map_err(|e| invalid(format!("[deployment] baseline '{}': {e}", b.name)))?;
+                if b.name.is_empty() || b.name.contains(['/', '\\']) || ARMS.contains(&b.name.as_str()) {
+                    return Err(invalid(format!(
+                        "[deployment] baseline name '{}' must be a plain folder name other than {ARMS:?}",
+                        b.name
+                    )));
+                }
+            }
         }
         if !p.alias.is_empty() && p.alias.len() != 2 {
             return Err(invalid(format!(
@@ -210,7 +262,8 @@ mod tests {
             Protocol::find("cylinder_2d_re200", "Cylinder_2D_Re1000").unwrap().name,
             "cylinder_re200_re1000"
         );
-        let e = Protocol::find("channel", "naca0012").unwrap_err().to_string();
+        assert_eq!(Protocol::find("channel", "NACA0012").unwrap().name, "channel_wing");
+        let e = Protocol::find("channel", "cylinder").unwrap_err().to_string();
         assert!(e.contains("Cylinder_2D_Re200 SquareCylinder_2D_Re200"), "{e}");
     }
 }
