@@ -76,6 +76,14 @@ pub struct DeploymentComparison {
     pub cost: Cost,
 }
 
+/// An arm's wall-shear profile: mean and spread over its deployments at each `x`.
+struct Profile {
+    arm: String,
+    x: Vec<f64>,
+    mean: Vec<f64>,
+    std: Vec<f64>,
+}
+
 /// Episodes of a training run: its samples over the transitions of one episode (one per agent
 /// and action).
 fn episodes(src: &SourceRun) -> Result<f64, CompareError> {
@@ -105,7 +113,7 @@ pub fn analyse(
         records.push(json(&dir.join("deployment.json"))?);
     }
     let mut arms: Vec<ArmSummary> = vec![];
-    let mut lines: Vec<(String, Vec<f64>, Vec<f64>, Vec<f64>)> = vec![];
+    let mut lines: Vec<Profile> = vec![];
     for r in &records {
         let group: Vec<&ArmRecord> = records.iter().filter(|o| o.arm == r.arm).collect();
         if arms.iter().any(|a| a.arm == r.arm) {
@@ -129,7 +137,12 @@ pub fn analyse(
         let n = r.profile.len();
         let at = |i: usize| group.iter().map(|g| 1.0 + g.profile[i]).collect::<Vec<_>>();
         let (mean, std): (Vec<f64>, Vec<f64>) = (0..n).map(|i| Stat::of(&at(i))).map(|s| (s.mean, s.std)).unzip();
-        lines.push((r.arm.clone(), r.x.clone(), mean, std));
+        lines.push(Profile {
+            arm: r.arm.clone(),
+            x: r.x.clone(),
+            mean,
+            std,
+        });
     }
     let zeroshot = arms.iter().find(|a| a.arm == "zeroshot").ok_or_else(|| CompareError::Invalid {
         path: root.to_path_buf(),
@@ -158,11 +171,11 @@ pub fn analyse(
     };
     let drawn: Vec<Line> = lines
         .iter()
-        .map(|(label, x, y, band)| Line {
-            label,
-            x,
-            y,
-            band: Some(band),
+        .map(|p| Line {
+            label: &p.arm,
+            x: &p.x,
+            y: &p.mean,
+            band: Some(&p.std),
         })
         .collect();
     plots::lines(
