@@ -257,7 +257,7 @@ baselines = [
     let cmp = json(&root.join("comparison.json"));
     assert_eq!(cmp["schema"], "hgym/transfer-deployment/v1");
     let arms: Vec<&str> = cmp["arms"].as_array().unwrap().iter().map(|a| a["arm"].as_str().unwrap()).collect();
-    assert_eq!(arms, ["uncontrolled", "zeroshot", "opposition", "blowing"]);
+    assert_eq!(arms, ["uncontrolled", "opposition", "blowing", "zeroshot"]);
     assert_eq!(cmp["arms"][0]["local_friction_reduction_pct"]["mean"], 0.0);
     for dir in ["uncontrolled", "zeroshot/seed0", "opposition", "blowing"] {
         let rec = json(&root.join(dir).join("deployment.json"));

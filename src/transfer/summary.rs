@@ -22,17 +22,14 @@ use crate::train::compare::CompareError;
 pub const SCHEMA: &str = "hgym/transfer-deployment/v1";
 
 /// The folder of each deployment arm under the protocol's root, in order: the uncontrolled
-/// flow, the zero-shot arm of each seed, each baseline.
+/// flow, each baseline (neither needs the source runs), the zero-shot arm of each seed.
 pub fn arm_dirs(p: &Protocol, root: &Path) -> Vec<(String, Option<u64>, std::path::PathBuf)> {
     let mut dirs = vec![("uncontrolled".to_string(), None, root.join("uncontrolled"))];
-    dirs.extend(
-        p.seeds
-            .iter()
-            .map(|&s| ("zeroshot".to_string(), Some(s), p.arm_dir(root, "zeroshot", s))),
-    );
     if let Some(d) = &p.deployment {
         dirs.extend(d.baselines.iter().map(|b| (b.name.clone(), None, root.join(&b.name))));
     }
+    let zeroshot = |&s: &u64| ("zeroshot".to_string(), Some(s), p.arm_dir(root, "zeroshot", s));
+    dirs.extend(p.seeds.iter().map(zeroshot));
     dirs
 }
 
