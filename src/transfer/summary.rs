@@ -178,7 +178,7 @@ pub fn analyse(
     plots::lines(
         &root.join("friction.png"),
         &format!("{}: wall shear stress over the uncontrolled flow's, span- and time-mean", p.target),
-        "x / c (arc length from the leading edge)",
+        "x (chords along the wall from the box's inflow)",
         "tau_w / tau_w,0(x)",
         &drawn,
     )?;
