@@ -272,4 +272,13 @@ baselines = [
     assert!(root.join("friction.png").exists() && root.join("reductions.png").exists());
     let o = hgym(&args);
     assert!(o.status.success() && text(&o).matches("done already").count() == 4, "{}", text(&o));
+    // Another blowing amplitude does not reuse the old arm: refused, naming what differs.
+    std::fs::write(&pfile, protocol.replace("constant=0.5", "constant=0.25")).unwrap();
+    let o = hgym(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        text(&o).contains("policy constant=0.5") && text(&o).contains("move it away"),
+        "{}",
+        text(&o)
+    );
 }

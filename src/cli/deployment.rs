@@ -2,8 +2,9 @@
 //! wing): the uncontrolled flow, the source policy of each seed and the classical controllers
 //! deployed on the target ([`hgym::transfer::deploy`]), then their comparison
 //! ([`hgym::transfer::summary`]). Each arm is a folder with `deployment.json`, `tau_w.png` and an
-//! evaluation's `metrics.json` and `manifest.json`; an arm whose folder holds `deployment.json`
-//! is not run again, so Ctrl-C loses only the arm in progress.
+//! evaluation's `metrics.json` and `manifest.json`. An arm whose folder holds the
+//! `deployment.json` of the same set-up (spec, policy, settle actions, episodes) is not run
+//! again, so Ctrl-C loses only the arm in progress; one of another set-up is refused.
 
 use std::path::Path;
 use std::time::Instant;
@@ -50,18 +51,6 @@ pub fn run(
             k + 1,
             arms.len()
         );
-        if dir.join("deployment.json").exists() {
-            eprintln!("{label}: done already ({})", dir.display());
-            continue;
-        }
-        if analyse_only {
-            return Err(UsageError(format!(
-                "{}: the arm {label} has not run ({} has no deployment.json); run the protocol without --analyse-only",
-                p.name,
-                dir.display()
-            ))
-            .into());
-        }
         let (spec, mut policy, name): (Spec, Box<dyn Policy + Send>, String) = match (arm.as_str(), seed) {
             ("uncontrolled", _) => (target.clone(), Box::new(BaselinePolicy::new(Baseline::Zero, 0)), "zero".into()),
             ("zeroshot", Some(s)) => {
@@ -90,6 +79,36 @@ pub fn run(
                 (spec, Box::new(policy), b.policy.clone())
             }
         };
+        if dir.join("deployment.json").exists() {
+            let r = read_record(dir)?;
+            let made = (r.spec_hash.as_str(), r.policy.as_str(), r.settle_actions, r.episodes.len() as u64);
+            if made != (spec.hash().as_str(), name.as_str(), d.settle_actions, d.episodes) {
+                return Err(UsageError(format!(
+                    "{}: {} was made by another set-up (spec {}, policy {}, settle_actions {}, {} episodes; the protocol \
+                     now asks for spec {}, policy {name}, settle_actions {}, {} episodes); move it away to deploy again",
+                    p.name,
+                    dir.display(),
+                    &r.spec_hash[..8.min(r.spec_hash.len())],
+                    r.policy,
+                    r.settle_actions,
+                    r.episodes.len(),
+                    &spec.hash()[..8],
+                    d.settle_actions,
+                    d.episodes
+                ))
+                .into());
+            }
+            eprintln!("{label}: done already ({})", dir.display());
+            continue;
+        }
+        if analyse_only {
+            return Err(UsageError(format!(
+                "{}: the arm {label} has not run ({} has no deployment.json); run the protocol without --analyse-only",
+                p.name,
+                dir.display()
+            ))
+            .into());
+        }
         let reference: Option<Vec<DeployEpisode>> = match arm.as_str() {
             "uncontrolled" => None,
             _ => {
