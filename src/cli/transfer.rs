@@ -73,6 +73,12 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
             )));
         }
         let src = SourceRun::load(&dir).map_err(usage)?;
+        // A run to remake is remade with the configuration it was trained with.
+        let remake = || -> Result<String> {
+            let file = root.join("source-train.toml");
+            std::fs::write(&file, &src.config_toml).with_context(|| format!("cannot write {}", file.display()))?;
+            Ok(p.source_command(&file))
+        };
         if p.init_critics && !dir.join(hgym::train::checkpoint::FILE).exists() {
             return Err(usage(format!(
                 "{}: the fine-tuning arm starts from the source's critics, and {} has no checkpoint (run folders commit \
@@ -81,7 +87,7 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
                  same, elsewhere as other runs of the same set-up):\n  {}",
                 p.name,
                 dir.display(),
-                p.source_command(&config_file)
+                remake()?
             )));
         }
         if src.spec_hash != p.source_spec_hash || src.env_id != p.source || src.algo != p.algo {
@@ -95,7 +101,7 @@ pub fn run(args: TransferArgs) -> Result<Outcome> {
                 p.source,
                 p.algo,
                 &p.source_spec_hash[..8.min(p.source_spec_hash.len())],
-                p.source_command(&config_file)
+                remake()?
             )));
         }
         sources.push(src);

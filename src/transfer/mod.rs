@@ -76,6 +76,8 @@ pub struct SourceRun {
     pub level: String,
     /// Today's registered spec with the run's `[env]` overrides (its layout is read from here).
     pub spec: Spec,
+    /// The training configuration the run was made with (its manifest's `config_toml`).
+    pub config_toml: String,
 }
 
 impl SourceRun {
@@ -111,6 +113,7 @@ impl SourceRun {
             seed: m.seed,
             level: m.level,
             spec,
+            config_toml: m.config_toml,
         })
     }
 
@@ -213,6 +216,7 @@ mod tests {
             seed: 0,
             level: "default".into(),
             spec,
+            config_toml: String::new(),
         }
     }
 

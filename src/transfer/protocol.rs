@@ -213,8 +213,8 @@ impl Protocol {
     }
 
     /// The command that makes the source runs: the bundled protocol whose from-scratch arm
-    /// they are, else `hgym train` with `config` (the file holding
-    /// [`Protocol::config`]) into the folders `source_runs` names.
+    /// they are, else `hgym train` with the configuration file `config` (a run's own when it is
+    /// remade, else [`Protocol::config`]) into the folders `source_runs` names.
     pub fn source_command(&self, config: &Path) -> String {
         let seed = self.seeds[0];
         let dir = self.source_dir(seed);
