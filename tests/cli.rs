@@ -506,6 +506,25 @@ fn bench_quick_reports_mlups_and_roofline_fraction() {
     }
 }
 
+/// `--size` replaces the memory-bound size; a malformed size or one of the other dimension is a
+/// usage error that says what to give.
+#[test]
+fn bench_lbm_size_is_checked_and_used() {
+    let o = hgym(&["bench", "lbm", "--quick", "--json", "--size", "96x40"]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let last = &v["rows"].as_array().unwrap()[2];
+    assert_eq!((last["nx"].as_u64(), last["ny"].as_u64()), (Some(96), Some(40)));
+    assert!(["stream", "memcpy"].contains(&last["copy_method"].as_str().unwrap()));
+    for (size, says) in [("12x3", "NXxNY"), ("64x64x64", "does not fit --lattice d2q9"), ("ax8", "NXxNY")] {
+        let o = hgym(&["bench", "lbm", "--quick", "--size", size]);
+        let (_, err) = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{size}: {err}");
+        assert!(err.contains(says), "{size}: {err}");
+    }
+}
+
 /// `hgym bench channel --quick`: steps/s and simulated t+ per second of the minimal and the full
 /// channel, 1 and 2 threads, consistent with each other; no peer, so nothing is judged.
 #[test]

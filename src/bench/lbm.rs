@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::BenchError;
 
-use super::stream::stream_copy_gbs;
+use super::stream::{default_copy_values, last_level_cache_bytes, stream_copy_gbs, CopyMethod};
 
 /// The velocity set a benchmark times.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -49,14 +49,31 @@ impl BenchLattice {
         }
     }
 
-    /// A cache-resident, a last-level-cache and a memory-bound size (the last one, well above
-    /// this machine's 32 MB L3).
-    pub fn default_sizes(self) -> Vec<[usize; 3]> {
+    /// A cache-resident, a last-level-cache and a memory-bound size. The last holds at least
+    /// four times the last-level cache of `llc_bytes` (2048^2 and 160^3 at least), so that no
+    /// replacement policy keeps a useful share of it cached.
+    pub fn default_sizes(self, llc_bytes: usize) -> Vec<[usize; 3]> {
+        let bytes = self.bytes_per_cell();
+        // The smallest side, a multiple of `step` and at least `min`, whose `dim`-cube holds
+        // 4 x `llc_bytes`.
+        let side = |dim: u32, min: usize, step: usize| {
+            let mut n = min;
+            while n.pow(dim) * bytes < 4 * llc_bytes {
+                n += step;
+            }
+            n
+        };
         match self {
-            // 0.3 MB, 9.4 MB, 302 MB at 72 B per node.
-            BenchLattice::D2q9 => vec![[64, 64, 1], [512, 256, 1], [2048, 2048, 1]],
-            // D3Q19: 2.1 MB, 40 MB, 623 MB (D3Q27: 3.0, 57, 885 MB).
-            _ => vec![[24, 24, 24], [64, 64, 64], [160, 160, 160]],
+            // 0.3 MB, 9.4 MB, then 302 MB for a 32 MB cache (1.2 GB at 4096^2 for 260 MB).
+            BenchLattice::D2q9 => {
+                let n = side(2, 2048, 256);
+                vec![[64, 64, 1], [512, 256, 1], [n, n, 1]]
+            }
+            // D3Q19: 2.1 MB, 40 MB, then 623 MB for a 32 MB cache (D3Q27: 3.0, 57, 885 MB).
+            _ => {
+                let n = side(3, 160, 16);
+                vec![[24, 24, 24], [64, 64, 64], [n, n, n]]
+            }
         }
     }
 }
@@ -74,8 +91,12 @@ pub struct BenchRow {
     pub mlups: f64,
     /// Bytes moved per second by the kernel, at `bytes_per_cell` per update.
     pub kernel_gbs: f64,
-    /// STREAM copy bandwidth measured in the same run with the same thread count.
+    /// Copy bandwidth measured in the same run with the same thread count: the faster of
+    /// STREAM's ordinary loop and `memcpy` ([`CopyMethod`]).
     pub copy_gbs: f64,
+    /// The copy that reached `copy_gbs`.
+    #[serde(default = "stream_method")]
+    pub copy_method: CopyMethod,
     pub roofline_mlups: f64,
     pub roofline_fraction: f64,
     /// The correctness check at this size: largest velocity error of the Taylor-Green vortex
@@ -86,6 +107,10 @@ pub struct BenchRow {
 
 fn one() -> usize {
     1
+}
+
+fn stream_method() -> CopyMethod {
+    CopyMethod::Stream
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -124,10 +149,10 @@ impl Default for LbmBenchOptions {
     fn default() -> Self {
         LbmBenchOptions {
             lattice: BenchLattice::D2q9,
-            sizes: BenchLattice::D2q9.default_sizes(),
+            sizes: BenchLattice::D2q9.default_sizes(last_level_cache_bytes().unwrap_or(32 << 20)),
             threads: vec![1, 2],
             seconds: 1.5,
-            stream_values: 1 << 26,
+            stream_values: default_copy_values(),
             collision: Collision::Regularized,
         }
     }
@@ -239,7 +264,8 @@ pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Resu
             // The copy is measured right before each row (best of 5), and the kernel is timed as
             // the best of 3 runs, so both see the machine in the same state (this VM's
             // bandwidth moves by +-20 % between minutes).
-            let copy_gbs = pool.install(|| stream_copy_gbs(opts.stream_values, 5));
+            let copy = pool.install(|| stream_copy_gbs(opts.stream_values, 5));
+            let copy_gbs = copy.gbs;
             let row = pool.install(|| -> Result<BenchRow, BenchError> {
                 let (mut s, kw) = taylor_green(opts.lattice, n, opts.collision)?;
                 s.advance(3)?;
@@ -277,6 +303,7 @@ pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Resu
                     mlups,
                     kernel_gbs: mlups * 1e6 * bytes as f64 / 1e9,
                     copy_gbs,
+                    copy_method: copy.method,
                     roofline_mlups: roofline,
                     roofline_fraction: mlups / roofline,
                     check_error: err,
@@ -333,24 +360,25 @@ fn grid_name(r: &BenchRow) -> String {
 impl BenchReport {
     pub fn table(&self) -> String {
         let mut s = format!(
-            "{} FP32 step, {} bytes per cell update; roofline = STREAM copy bandwidth / {}\n",
+            "{} FP32 step, {} bytes per cell update; roofline = copy bandwidth (the faster of STREAM's loop and memcpy) / {}\n",
             self.lattice.name().to_uppercase(),
             self.bytes_per_cell,
             self.bytes_per_cell
         );
         s += &format!(
-            "  {:>11} {:>9} {:>7} {:>9} {:>10} {:>10} {:>10} {:>9}  {}\n",
-            "grid", "MB", "threads", "MLUPS", "kern GB/s", "copy GB/s", "roof MLUPS", "fraction", "check"
+            "  {:>11} {:>9} {:>7} {:>9} {:>10} {:>10} {:>7} {:>10} {:>9}  {}\n",
+            "grid", "MB", "threads", "MLUPS", "kern GB/s", "copy GB/s", "copy", "roof MLUPS", "fraction", "check"
         );
         for r in &self.rows {
             s += &format!(
-                "  {:>11} {:>9.1} {:>7} {:>9.1} {:>10.2} {:>10.2} {:>10.1} {:>8.0}%  TG err {:.1e}{}\n",
+                "  {:>11} {:>9.1} {:>7} {:>9.1} {:>10.2} {:>10.2} {:>7} {:>10.1} {:>8.0}%  TG err {:.1e}{}\n",
                 grid_name(r),
                 r.megabytes,
                 r.threads,
                 r.mlups,
                 r.kernel_gbs,
                 r.copy_gbs,
+                r.copy_method.name(),
                 r.roofline_mlups,
                 100.0 * r.roofline_fraction,
                 r.check_error,

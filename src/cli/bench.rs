@@ -28,6 +28,11 @@ pub enum BenchCommand {
         /// Collision operator to time.
         #[arg(long, value_enum, default_value = "regularized")]
         collision: CollisionArg,
+        /// The memory-bound size, NXxNY (2D) or NXxNYxNZ (3D), instead of the default: the
+        /// smallest of 2048^2 or 160^3 and up whose two population arrays hold four times the
+        /// last-level cache (e.g. 4096x4096, 1.2 GB, for a 260 MB cache).
+        #[arg(long, value_parser = parse_size)]
+        size: Option<[usize; 3]>,
     },
     /// 2:1 grid refinement: node updates per second of a grid with a patch over its middle
     /// quarter (an eighth of a 3D box) against the uniform kernel on the same grid, 1 and 2
@@ -43,8 +48,9 @@ pub enum BenchCommand {
         #[arg(long)]
         quick: bool,
     },
-    /// The copy bandwidth `hgym bench lbm` takes as the machine's limit (STREAM copy, GB/s, read
-    /// + write), alone: `make roofline` runs it beside STREAM's C copy to check it is as fast.
+    /// The copy bandwidth `hgym bench lbm` takes as the machine's limit (GB/s, read + write; the
+    /// faster of STREAM's ordinary loop and memcpy), alone: `make roofline` runs it beside
+    /// STREAM's C copy to check it is at least as fast.
     Copy {
         /// Print one JSON line.
         #[arg(long)]
@@ -52,9 +58,10 @@ pub enum BenchCommand {
         /// Threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
-        /// f32 values per array (default 2^26: 256 MB each).
-        #[arg(long, default_value_t = 1 << 26)]
-        values: usize,
+        /// f32 values per array (default: each at least twice the last-level cache, and at least
+        /// 2^26 values, 256 MB).
+        #[arg(long)]
+        values: Option<usize>,
     },
     /// Learner speed: TD3 updates/s (256x256, batch 256), PPO epochs/s (64x64), batch-1 policy
     /// latency. With --peer, Stable-Baselines3's TD3 at the same shapes is timed in the same run,
@@ -164,18 +171,30 @@ pub fn run(cmd: BenchCommand) -> Result<Outcome> {
             quick,
             collision,
             lattice,
-        } => run_bench(json, quick, collision, lattice),
+            size,
+        } => run_bench(json, quick, collision, lattice, size),
         BenchCommand::Refine { json, quick, lattice } => run_bench_refine(json, quick, lattice),
         BenchCommand::Copy { json, threads, values } => {
+            let values = values.unwrap_or_else(hgym::bench::default_copy_values);
             if values < 1 << 20 {
                 return Err(UsageError("--values must be at least 1048576 (arrays far beyond the caches)".into()).into());
             }
             let (pool, n) = thread_pool(threads)?;
-            let gbs = pool.install(|| hgym::bench::stream_copy_gbs(values, 10));
+            let c = pool.install(|| hgym::bench::stream_copy_gbs(values, 10));
             if json {
-                println!("{}", serde_json::json!({"threads": n, "copy_gbs": gbs}));
+                println!(
+                    "{}",
+                    serde_json::json!({"threads": n, "values": values, "copy_gbs": c.gbs, "method": c.method, "stream_gbs": c.by_method[0], "memcpy_gbs": c.by_method[1]})
+                );
             } else {
-                println!("STREAM copy, {n} thread(s), 2 x {} MB: {gbs:.2} GB/s", (values * 4) >> 20);
+                println!(
+                    "copy, {n} thread(s), 2 x {} MB: {:.2} GB/s ({}; STREAM's loop {:.2}, memcpy {:.2})",
+                    (values * 4) >> 20,
+                    c.gbs,
+                    c.method.name(),
+                    c.by_method[0],
+                    c.by_method[1]
+                );
             }
             Ok(Outcome::Ok)
         }
@@ -223,14 +242,29 @@ fn print_report(json: bool, report: &impl serde::Serialize, table: &str) -> Resu
     Ok(())
 }
 
-fn run_bench(json: bool, quick: bool, collision: CollisionArg, lattice: LatticeArg) -> Result<Outcome> {
+/// `NXxNY` or `NXxNYxNZ`, each at least 8.
+fn parse_size(s: &str) -> Result<[usize; 3], String> {
+    let bad = || format!("{s:?}: give the size as NXxNY (2D) or NXxNYxNZ (3D), each at least 8, e.g. 4096x4096");
+    let n: Vec<usize> = s
+        .split('x')
+        .map(|v| v.trim().parse::<usize>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| bad())?;
+    match n[..] {
+        [nx, ny] if nx.min(ny) >= 8 => Ok([nx, ny, 1]),
+        [nx, ny, nz] if nx.min(ny).min(nz) >= 8 => Ok([nx, ny, nz]),
+        _ => Err(bad()),
+    }
+}
+
+fn run_bench(json: bool, quick: bool, collision: CollisionArg, lattice: LatticeArg, size: Option<[usize; 3]>) -> Result<Outcome> {
     let lattice = bench_lattice(lattice);
     if lattice != BenchLattice::D2q9 && matches!(collision, CollisionArg::Recursive) {
         return Err(UsageError("--collision recursive is 2D only; use bgk or regularized with a 3D lattice".into()).into());
     }
     let mut opts = LbmBenchOptions {
         lattice,
-        sizes: lattice.default_sizes(),
+        sizes: lattice.default_sizes(hgym::bench::last_level_cache_bytes().unwrap_or(32 << 20)),
         collision: match collision {
             CollisionArg::Bgk => hgym_solvers::lbm::Collision::Bgk,
             CollisionArg::Regularized => hgym_solvers::lbm::Collision::Regularized,
@@ -245,6 +279,21 @@ fn run_bench(json: bool, quick: bool, collision: CollisionArg, lattice: LatticeA
         };
         opts.seconds = 0.05;
         opts.stream_values = 1 << 22;
+    }
+    if let Some(n) = size {
+        if (n[2] > 1) != (lattice != BenchLattice::D2q9) {
+            return Err(UsageError(format!(
+                "--size {}x{}x{} does not fit --lattice {}: give NXxNY in 2D, NXxNYxNZ in 3D",
+                n[0],
+                n[1],
+                n[2],
+                lattice.name()
+            ))
+            .into());
+        }
+        if let Some(last) = opts.sizes.last_mut() {
+            *last = n;
+        }
     }
     let quiet = json;
     let report = bench_lbm(&opts, &mut |msg| {
