@@ -222,6 +222,16 @@ fn unknown_pairs_and_missing_sources_exit_2_saying_what_to_run() {
 #[test]
 fn a_deployment_protocol_runs_every_arm_and_compares_them() {
     let tmp = tempfile::tempdir().unwrap();
+    // The source run, copied so that the test can retrain it (below).
+    let source = tmp.path().join("source/seed0");
+    std::fs::create_dir_all(&source).unwrap();
+    for f in ["policy.json", "manifest.json"] {
+        std::fs::copy(
+            Path::new("results/train/TCFMini_3D_Retau180-td3-default/seed0").join(f),
+            source.join(f),
+        )
+        .unwrap();
+    }
     let pfile = tmp.path().join("wing.toml");
     let protocol = r#"
 name = "mini_wing"
@@ -232,7 +242,7 @@ algo = "td3"
 level = "coarse"
 seeds = [0]
 source_spec_hash = "23584c5aa36fc9675cf26cd72b2a2765426e94939f81069586fb297caf193118"
-source_runs = "results/train/TCFMini_3D_Retau180-td3-default/seed{seed}"
+source_runs = "SOURCE/seed{seed}"
 fraction = 0.9
 [deployment]
 episodes = 2
@@ -243,7 +253,8 @@ baselines = [
     { name = "blowing", policy = "constant=0.5", env = { zero_net_flux = false } },
 ]
 "#;
-    std::fs::write(&pfile, protocol).unwrap();
+    let protocol = protocol.replace("SOURCE", tmp.path().join("source").to_str().unwrap());
+    std::fs::write(&pfile, &protocol).unwrap();
     let args = [
         "transfer",
         "--protocol",
@@ -281,4 +292,12 @@ baselines = [
         "{}",
         text(&o)
     );
+    // A source retrained in the same folder is not taken for the one deployed.
+    std::fs::write(&pfile, &protocol).unwrap();
+    let policy = source.join("policy.json");
+    let retrained = std::fs::read_to_string(&policy).unwrap() + "\n";
+    std::fs::write(&policy, retrained).unwrap();
+    let o = hgym(&args);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("the source was retrained"), "{}", text(&o));
 }

@@ -51,6 +51,7 @@ pub fn run(
             k + 1,
             arms.len()
         );
+        let mut source_sha: Option<String> = None;
         let (spec, mut policy, name): (Spec, Box<dyn Policy + Send>, String) = match (arm.as_str(), seed) {
             ("uncontrolled", _) => (target.clone(), Box::new(BaselinePolicy::new(Baseline::Zero, 0)), "zero".into()),
             ("zeroshot", Some(s)) => {
@@ -59,6 +60,7 @@ pub fn run(
                     .find(|src| src.seed == *s)
                     .with_context(|| format!("no source run of seed {s}"))?;
                 let init = init_from(src, target, &p.mapping, false, false)?;
+                source_sha = Some(src.policy_sha256.clone());
                 (target.clone(), Box::new(init.policy), src.dir.display().to_string())
             }
             _ => {
@@ -98,6 +100,21 @@ pub fn run(
                 ))
                 .into());
             }
+            // Records from before the hash was kept carry none and are taken at their word.
+            if let (Some(made), Some(now)) = (&r.policy_sha256, &source_sha) {
+                if made != now {
+                    return Err(UsageError(format!(
+                        "{}: {} deployed another policy.json of {} (SHA-256 {}, now {}): the source was retrained; move \
+                         the arm away to deploy the new policy",
+                        p.name,
+                        dir.display(),
+                        name,
+                        &made[..8.min(made.len())],
+                        &now[..8]
+                    ))
+                    .into());
+                }
+            }
             eprintln!("{label}: done already ({})", dir.display());
             continue;
         }
@@ -134,7 +151,8 @@ pub fn run(
         bar.finish_and_clear();
         let (wall, cpu_s) = (started.elapsed().as_secs_f64(), cpu.total(Some(0.0)));
         let ids = [name.as_str(), spec.id(), &spec.hash(), p.level.name()];
-        let record = deployed.record(arm, *seed, ids, d.settle_actions, cpu_s.unwrap_or(f64::NAN));
+        let mut record = deployed.record(arm, *seed, ids, d.settle_actions, cpu_s.unwrap_or(f64::NAN));
+        record.policy_sha256 = source_sha;
         let report = hgym::train::eval::EvalReport::of(deployed.eval.clone(), &name, spec.id(), &spec.hash(), p.level.name());
         let config_toml = arm_env_toml(p, arm);
         let run = EvalRun {

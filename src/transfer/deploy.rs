@@ -90,6 +90,7 @@ impl Deployment {
             arm: arm.into(),
             seed,
             policy: ids[0].into(),
+            policy_sha256: None,
             env_id: ids[1].into(),
             spec_hash: ids[2].into(),
             level: ids[3].into(),
@@ -116,6 +117,10 @@ pub struct ArmRecord {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub seed: Option<u64>,
     pub policy: String,
+    /// A zero-shot arm's: SHA-256 of the source's `policy.json` it deployed (a source retrained
+    /// in the same folder is then told apart).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub policy_sha256: Option<String>,
     pub env_id: String,
     pub spec_hash: String,
     pub level: String,

@@ -78,6 +78,8 @@ pub struct SourceRun {
     pub spec: Spec,
     /// The training configuration the run was made with (its manifest's `config_toml`).
     pub config_toml: String,
+    /// SHA-256 of its `policy.json`.
+    pub policy_sha256: String,
 }
 
 impl SourceRun {
@@ -91,6 +93,12 @@ impl SourceRun {
                 dir.display()
             )));
         }
+        let policy_file = dir.join("policy.json");
+        let bytes = std::fs::read(&policy_file).map_err(|source| TransferError::Read {
+            path: policy_file.clone(),
+            source,
+        })?;
+        let policy_sha256 = format!("{:x}", <sha2::Sha256 as sha2::Digest>::digest(&bytes));
         let policy = match parse_policy(&dir.display().to_string()) {
             Ok(NamedPolicy::Trained(p)) => *p,
             Ok(NamedPolicy::Baseline(_)) => return Err(bad(format!("{} names a baseline, not a run folder", dir.display()))),
@@ -114,6 +122,7 @@ impl SourceRun {
             level: m.level,
             spec,
             config_toml: m.config_toml,
+            policy_sha256,
         })
     }
 
@@ -217,6 +226,7 @@ mod tests {
             level: "default".into(),
             spec,
             config_toml: String::new(),
+            policy_sha256: String::new(),
         }
     }
 

@@ -107,7 +107,22 @@ pub fn analyse(
 ) -> Result<DeploymentComparison, CompareError> {
     let mut records: Vec<ArmRecord> = vec![];
     for (_, _, dir) in arm_dirs(p, root) {
-        records.push(json(&dir.join("deployment.json"))?);
+        let file = dir.join("deployment.json");
+        let r: ArmRecord = json(&file)?;
+        // Every arm's friction profile is sampled at the same stations (the same target grid).
+        let stations = records.first().map_or(r.x.len(), |f| f.x.len());
+        if r.profile.len() != r.x.len() || records.first().is_some_and(|f| f.x != r.x) {
+            return Err(CompareError::Invalid {
+                path: file,
+                message: format!(
+                    "its friction profile has {} values at {} stations, the first arm's {stations}: the arms ran on \
+                     different set-ups, or the file was cut; delete this arm's folder and run the protocol again",
+                    r.profile.len(),
+                    r.x.len(),
+                ),
+            });
+        }
+        records.push(r);
     }
     let mut arms: Vec<ArmSummary> = vec![];
     let mut lines: Vec<Profile> = vec![];
@@ -249,4 +264,35 @@ fn target_plots(root: &Path, id: &str, t: &TargetCheck) -> Result<(), CompareErr
         plots::lines(&root.join(file), &title, "x / c", quantity, &lines)?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An arm whose friction profile is not sampled where the others' are is refused by name,
+    /// not indexed past its end.
+    #[test]
+    fn arms_of_another_grid_are_refused() {
+        let p = Protocol::find("channel", "naca0012").unwrap();
+        let tmp = tempfile::tempdir().unwrap();
+        let committed = Path::new("results/transfer/channel_wing/uncontrolled/deployment.json");
+        let mut r: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(committed).unwrap()).unwrap();
+        for (arm, cut) in [("uncontrolled", false), ("opposition", true)] {
+            let dir = tmp.path().join(arm);
+            std::fs::create_dir_all(&dir).unwrap();
+            if cut {
+                r["arm"] = arm.into();
+                r["profile"].as_array_mut().unwrap().pop();
+            }
+            std::fs::write(dir.join("deployment.json"), r.to_string()).unwrap();
+        }
+        match analyse(&p, tmp.path(), &[], None) {
+            Err(CompareError::Invalid { path, message }) => {
+                assert!(path.ends_with("opposition/deployment.json"), "{}", path.display());
+                assert!(message.contains("different set-ups"), "{message}");
+            }
+            other => panic!("expected the opposition arm refused, got {other:?}"),
+        }
+    }
 }
