@@ -6,11 +6,11 @@
 //! system's limit depends on the processor:
 //! - [`CopyMethod::Stream`]: STREAM's C copy as `gcc -O3 -march=native -fopenmp` compiles it, an
 //!   ordinary vector loop in ascending order ([`copy_ordinary`]). Each store first reads its
-//!   line (write-allocate). On the AMD EPYC machines of earlier stops it was the faster copy.
+//!   line (write-allocate). On AMD EPYC (Zen) it is the faster copy.
 //! - [`CopyMethod::Memcpy`]: the C library's `memcpy` of each thread's block. For blocks this
 //!   large glibc prefetches in software and stores non-temporally, so no line is read before it
-//!   is written: on the Intel Xeon (Sapphire Rapids) of stop 67 it moves 1.8 times as much as
-//!   the ordinary loop (about 45 against 25 GB/s with 2 threads, 22 against 12.5 with 1).
+//!   is written: on an Intel Xeon (Emerald Rapids) it moves 1.7 times as much as the ordinary
+//!   loop (about 42 against 25 GB/s with 2 threads, 21 against 12.5 with 1).
 //!
 //! The arrays are first touched in parallel in the partition the copy uses; each thread copies
 //! one contiguous block; best of `reps` per method, the methods alternating. `make roofline`
@@ -90,8 +90,8 @@ pub fn stream_copy_gbs(n: usize, reps: usize) -> CopyBandwidth {
 
 /// `dst = src` with ordinary (write-allocate) 8-wide vector stores in ascending order, as gcc
 /// compiles STREAM's loop. Each 8-value block's source goes through `black_box`, so the loop is
-/// not recognised as one `memcpy`, and each iteration is one load and one store: with larger
-/// blocks LLVM emitted a block's stores in descending order, which moved 20-30 % less here.
+/// not recognised as one `memcpy`, and each iteration is one load and one store (with larger
+/// blocks LLVM emits a block's stores in descending order).
 fn copy_ordinary(dst: &mut [f32], src: &[f32]) {
     let (d, d_rest) = dst.as_chunks_mut::<8>();
     let (s, s_rest) = src.as_chunks::<8>();
