@@ -17,6 +17,14 @@ fn text(o: &Output) -> (String, String) {
     )
 }
 
+/// The JSON `hgym args` prints, after asserting that it succeeded.
+fn json_of(args: &[&str]) -> serde_json::Value {
+    let o = hgym(args);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "hgym {}: {err}", args.join(" "));
+    serde_json::from_str(&out).expect("JSON")
+}
+
 mod common;
 use common::repo;
 
@@ -491,10 +499,7 @@ fn json_output_is_machine_readable() {
 #[test]
 fn bench_quick_reports_mlups_and_roofline_fraction() {
     for (lattice, collision, bytes) in [("d2q9", "regularized", 72), ("d3q19", "bgk", 152), ("d3q27", "regularized", 216)] {
-        let o = hgym(&["bench", "lbm", "--quick", "--json", "--lattice", lattice, "--collision", collision]);
-        let (out, err) = text(&o);
-        assert!(o.status.success(), "{lattice} {collision}: {err}");
-        let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+        let v = json_of(&["bench", "lbm", "--quick", "--json", "--lattice", lattice, "--collision", collision]);
         let rows = v["rows"].as_array().unwrap();
         assert_eq!(rows.len(), 6);
         for r in rows {
@@ -510,10 +515,7 @@ fn bench_quick_reports_mlups_and_roofline_fraction() {
 /// usage error that says what to give.
 #[test]
 fn bench_lbm_size_is_checked_and_used() {
-    let o = hgym(&["bench", "lbm", "--quick", "--json", "--size", "96x40"]);
-    let (out, err) = text(&o);
-    assert!(o.status.success(), "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let v = json_of(&["bench", "lbm", "--quick", "--json", "--size", "96x40"]);
     let last = &v["rows"].as_array().unwrap()[2];
     assert_eq!((last["nx"].as_u64(), last["ny"].as_u64()), (Some(96), Some(40)));
     assert!(["stream", "memcpy"].contains(&last["copy_method"].as_str().unwrap()));
@@ -529,12 +531,9 @@ fn bench_lbm_size_is_checked_and_used() {
 /// channel, 1 and 2 threads, consistent with each other; no peer, so nothing is judged.
 #[test]
 fn bench_channel_quick_reports_simulated_time_per_second() {
-    let o = hgym(&["bench", "channel", "--quick", "--json", "--threads", "2"]);
-    let (out, err) = text(&o);
-    assert!(o.status.success(), "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let v = json_of(&["bench", "channel", "--quick", "--json", "--threads", "2"]);
     let rows = v["rows"].as_array().unwrap();
-    assert_eq!(rows.len(), 4, "{out}");
+    assert_eq!(rows.len(), 4, "{v}");
     for r in rows {
         let f = |k: &str| r[k].as_f64().unwrap();
         assert!(f("steps_per_s") > 0.0);
@@ -546,10 +545,7 @@ fn bench_channel_quick_reports_simulated_time_per_second() {
 
 #[test]
 fn bench_refine_quick_reports_the_ratio_to_the_uniform_kernel() {
-    let o = hgym(&["bench", "refine", "--quick", "--json"]);
-    let (out, err) = text(&o);
-    assert!(o.status.success(), "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let v = json_of(&["bench", "refine", "--quick", "--json"]);
     assert_eq!(v["schema"], "hgym/bench-refine/v1");
     let rows = v["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 2);
@@ -560,19 +556,16 @@ fn bench_refine_quick_reports_the_ratio_to_the_uniform_kernel() {
         // 128^2 coarse nodes and the 129^2 fine nodes over the middle 64^2 cells, stepped twice.
         assert_eq!(r["node_updates_per_step"], 128 * 128 + 2 * 129 * 129);
         for e in r["check_error"].as_array().unwrap() {
-            assert!(e.as_f64().unwrap() < 0.01, "{out}");
+            assert!(e.as_f64().unwrap() < 0.01, "{v}");
         }
     }
     // In 3D: a 64^3 box and the 65^3 fine nodes over its middle 32^3 cells.
-    let o = hgym(&["bench", "refine", "--lattice", "d3q19", "--quick", "--json"]);
-    let (out, err) = text(&o);
-    assert!(o.status.success(), "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).expect("JSON");
+    let v = json_of(&["bench", "refine", "--lattice", "d3q19", "--quick", "--json"]);
     assert_eq!(v["lattice"], "d3q19");
     for r in v["rows"].as_array().unwrap() {
         assert_eq!(r["node_updates_per_step"], 64 * 64 * 64 + 2 * 65 * 65 * 65);
         for e in r["check_error"].as_array().unwrap() {
-            assert!(e.as_f64().unwrap() < 0.01, "{out}");
+            assert!(e.as_f64().unwrap() < 0.01, "{v}");
         }
     }
 }

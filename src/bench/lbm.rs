@@ -149,7 +149,7 @@ impl Default for LbmBenchOptions {
     fn default() -> Self {
         LbmBenchOptions {
             lattice: BenchLattice::D2q9,
-            sizes: BenchLattice::D2q9.default_sizes(last_level_cache_bytes().unwrap_or(32 << 20)),
+            sizes: BenchLattice::D2q9.default_sizes(last_level_cache_bytes()),
             threads: vec![1, 2],
             seconds: 1.5,
             stream_values: default_copy_values(),

@@ -45,8 +45,9 @@ pub struct CopyBandwidth {
     /// GB/s, read + write.
     pub gbs: f64,
     pub method: CopyMethod,
-    /// Each method's best, GB/s: `[stream, memcpy]`.
-    pub by_method: [f64; 2],
+    /// Each method's best, GB/s.
+    pub stream_gbs: f64,
+    pub memcpy_gbs: f64,
 }
 
 /// Best-of-`reps` copy bandwidth over `n` f32 values, in the current rayon pool: the faster of
@@ -79,12 +80,16 @@ pub fn stream_copy_gbs(n: usize, reps: usize) -> CopyBandwidth {
             assert_eq!(b[n - 1], a[n - 1]);
         }
     }
-    let by_method = best.map(|t| 2.0 * (n * 4) as f64 / t / 1e9);
-    let m = if by_method[1] > by_method[0] { 1 } else { 0 };
+    let [stream_gbs, memcpy_gbs] = best.map(|t| 2.0 * (n * 4) as f64 / t / 1e9);
+    let (gbs, method) = match memcpy_gbs > stream_gbs {
+        true => (memcpy_gbs, CopyMethod::Memcpy),
+        false => (stream_gbs, CopyMethod::Stream),
+    };
     CopyBandwidth {
-        gbs: by_method[m],
-        method: methods[m],
-        by_method,
+        gbs,
+        method,
+        stream_gbs,
+        memcpy_gbs,
     }
 }
 
@@ -101,12 +106,14 @@ fn copy_ordinary(dst: &mut [f32], src: &[f32]) {
     d_rest.copy_from_slice(s_rest);
 }
 
-/// The size of the largest cache in bytes (Linux sysfs, CPU 0), `None` where it cannot be read.
-pub fn last_level_cache_bytes() -> Option<usize> {
-    let dir = std::fs::read_dir("/sys/devices/system/cpu/cpu0/cache").ok()?;
-    dir.filter_map(|e| std::fs::read_to_string(e.ok()?.path().join("size")).ok())
+/// The size of the largest cache in bytes (Linux sysfs, CPU 0); 32 MB where it cannot be read.
+pub fn last_level_cache_bytes() -> usize {
+    let sizes = std::fs::read_dir("/sys/devices/system/cpu/cpu0/cache").into_iter().flatten();
+    sizes
+        .filter_map(|e| std::fs::read_to_string(e.ok()?.path().join("size")).ok())
         .filter_map(|s| parse_cache_size(s.trim()))
         .max()
+        .unwrap_or(32 << 20)
 }
 
 /// A sysfs cache size (`"32768K"`, `"2M"`, `"512"`) in bytes.
@@ -128,8 +135,7 @@ fn parse_cache_size(s: &str) -> Option<usize> {
 /// f32 values per copy array: each array at least twice the last-level cache (2^26, 256 MB, at
 /// least), so the copy's 4 x cache bytes cannot stay cached under any replacement policy.
 pub fn default_copy_values() -> usize {
-    let llc = last_level_cache_bytes().unwrap_or(32 << 20);
-    (2 * llc / 4).next_power_of_two().max(1 << 26)
+    (2 * last_level_cache_bytes() / 4).next_power_of_two().max(1 << 26)
 }
 
 #[cfg(test)]
@@ -158,8 +164,15 @@ mod tests {
     #[test]
     fn the_limit_is_the_faster_copy() {
         let c = stream_copy_gbs(1 << 16, 2);
-        assert!(c.by_method.iter().all(|g| g.is_finite() && *g > 0.0));
-        assert_eq!(c.gbs, c.by_method[0].max(c.by_method[1]));
-        assert_eq!(c.gbs, c.by_method[if c.method == CopyMethod::Stream { 0 } else { 1 }]);
+        assert!([c.stream_gbs, c.memcpy_gbs].iter().all(|g| g.is_finite() && *g > 0.0));
+        assert_eq!(c.gbs, c.stream_gbs.max(c.memcpy_gbs));
+        assert_eq!(
+            c.gbs,
+            if c.method == CopyMethod::Stream {
+                c.stream_gbs
+            } else {
+                c.memcpy_gbs
+            }
+        );
     }
 }

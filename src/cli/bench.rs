@@ -184,7 +184,7 @@ pub fn run(cmd: BenchCommand) -> Result<Outcome> {
             if json {
                 println!(
                     "{}",
-                    serde_json::json!({"threads": n, "values": values, "copy_gbs": c.gbs, "method": c.method, "stream_gbs": c.by_method[0], "memcpy_gbs": c.by_method[1]})
+                    serde_json::json!({"threads": n, "values": values, "copy_gbs": c.gbs, "method": c.method, "stream_gbs": c.stream_gbs, "memcpy_gbs": c.memcpy_gbs})
                 );
             } else {
                 println!(
@@ -192,8 +192,8 @@ pub fn run(cmd: BenchCommand) -> Result<Outcome> {
                     (values * 4) >> 20,
                     c.gbs,
                     c.method.name(),
-                    c.by_method[0],
-                    c.by_method[1]
+                    c.stream_gbs,
+                    c.memcpy_gbs
                 );
             }
             Ok(Outcome::Ok)
@@ -264,7 +264,7 @@ fn run_bench(json: bool, quick: bool, collision: CollisionArg, lattice: LatticeA
     }
     let mut opts = LbmBenchOptions {
         lattice,
-        sizes: lattice.default_sizes(hgym::bench::last_level_cache_bytes().unwrap_or(32 << 20)),
+        sizes: lattice.default_sizes(hgym::bench::last_level_cache_bytes()),
         collision: match collision {
             CollisionArg::Bgk => hgym_solvers::lbm::Collision::Bgk,
             CollisionArg::Regularized => hgym_solvers::lbm::Collision::Regularized,
