@@ -216,3 +216,32 @@ fn adjoint_of_one_step_matches_finite_differences() {
 fn adjoint_of_100_steps_matches_finite_differences() {
     adjoint_check(100);
 }
+
+/// Steps and a VJP on a grid large enough for the transforms to run on two threads give the same
+/// bits as on one.
+#[test]
+fn bitwise_identical_across_thread_counts() {
+    let n = 256;
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mut s = Kolmogorov::new(cfg(n, 40.0, 0.01)).unwrap();
+            let lam = s.laminar();
+            s.set_vorticity(&smooth(n, 0.3));
+            s.omega.iter_mut().zip(&lam).for_each(|(w, l)| *w += *l);
+            let a = [0.1, -0.2, 0.05, 0.0];
+            for _ in 0..3 {
+                s.step(&a).unwrap();
+            }
+            let (w, bar1) = (s.omega.clone(), s.omega.clone());
+            let (mut bar0, mut bar_a) = (vec![C::default(); w.len()], vec![0.0; 4]);
+            s.step_vjp(&w, &a, &bar1, &mut bar0, &mut bar_a).unwrap();
+            (w, bar0, bar_a)
+        })
+    };
+    let bits = |r: (Vec<C>, Vec<C>, Vec<f64>)| -> Vec<u64> {
+        let c = r.0.iter().chain(&r.1).flat_map(|c| [c.re.to_bits(), c.im.to_bits()]);
+        c.chain(r.2.iter().map(|x| x.to_bits())).collect()
+    };
+    assert_eq!(bits(run(1)), bits(run(2)), "results depend on the thread count");
+}

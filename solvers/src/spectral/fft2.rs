@@ -23,7 +23,6 @@ pub struct Fft2 {
     inv: Arc<dyn Fft<f64>>,
     row: Vec<f64>,
     row_spec: Vec<Complex64>,
-    rows: Vec<Complex64>,
     cols: Vec<Complex64>,
     scratch_r: Vec<Complex64>,
     scratch_c: Vec<Complex64>,
@@ -52,7 +51,6 @@ impl Fft2 {
             inv,
             row: vec![0.0; n],
             row_spec: vec![Complex64::default(); nh],
-            rows: vec![Complex64::default(); n * nh],
             cols: vec![Complex64::default(); n * nh],
             scratch_r: vec![Complex64::default(); sr],
             scratch_c: vec![Complex64::default(); sc],
@@ -112,17 +110,9 @@ impl Fft2 {
         assert_eq!(phys.len(), n * n);
         let m = self.active * n;
         self.inv.process_with_scratch(&mut spec[..m], &mut self.scratch_c);
-        self.rows_inverse(spec, 0, phys);
-    }
-
-    /// The x-transforms of [`Fft2::inverse_destroying`] for the rows `y0..y0 + phys.len() / n`,
-    /// from `spec` already transformed along y.
-    fn rows_inverse(&mut self, spec: &[Complex64], y0: usize, phys: &mut [f64]) {
-        let (n, nh) = (self.n, self.nh);
         let scale = 1.0 / (n * n) as f64;
-        for (j, out) in phys.chunks_exact_mut(n).enumerate() {
-            let y = y0 + j;
-            let r = &mut self.rows[y * nh..(y + 1) * nh];
+        let r = &mut self.row_spec;
+        for (y, out) in phys.chunks_exact_mut(n).enumerate() {
             for kx in 0..self.active {
                 r[kx] = spec[kx * n + y] * scale;
             }
@@ -133,37 +123,6 @@ impl Fft2 {
             let _ = self.c2r.process_with_scratch(r, out, &mut self.scratch_r);
         }
     }
-}
-
-/// [`Fft2::inverse_destroying`] with its work split in two halves, run by `rayon::join` if
-/// `parallel`, else one after the other: the y-transforms of the first and the last active columns, then the
-/// x-transforms of the first and the last rows, `a` and `b` each with its own scratch (same-size
-/// plans). Every 1D transform is the one `a` alone computes, so the result is bitwise the same.
-pub fn inverse_destroying_split(a: &mut Fft2, b: &mut Fft2, spec: &mut [Complex64], phys: &mut [f64], parallel: bool) {
-    let join = |x: &mut (dyn FnMut() + Send), y: &mut (dyn FnMut() + Send)| {
-        if parallel {
-            rayon::join(x, y);
-        } else {
-            x();
-            y();
-        }
-    };
-    let (n, nh) = (a.n, a.nh);
-    assert!(b.n == n && b.active == a.active, "the two halves need same-size plans");
-    assert_eq!(spec.len(), n * nh);
-    assert_eq!(phys.len(), n * n);
-    let half = a.active / 2 * n;
-    let (first, last) = spec[..a.active * n].split_at_mut(half);
-    {
-        let (inv_a, scratch_a) = (&a.inv, &mut a.scratch_c);
-        let (inv_b, scratch_b) = (&b.inv, &mut b.scratch_c);
-        join(&mut || inv_a.process_with_scratch(first, scratch_a), &mut || {
-            inv_b.process_with_scratch(last, scratch_b)
-        });
-    }
-    let spec: &[Complex64] = spec;
-    let (top, bottom) = phys.split_at_mut(n / 2 * n);
-    join(&mut || a.rows_inverse(spec, 0, top), &mut || b.rows_inverse(spec, n / 2, bottom));
 }
 
 /// Signed wavenumber of y-index `iy` on an `n`-point grid.
@@ -245,21 +204,5 @@ mod tests {
             .iter()
             .zip(&two)
             .all(|(x, y)| x.re.to_bits() == y.re.to_bits() && x.im.to_bits() == y.im.to_bits()));
-    }
-
-    #[test]
-    fn the_split_inverse_is_bitwise_the_whole_one() {
-        for (n, active) in [(16, 6), (24, 9), (64, 22)] {
-            let (mut a, mut b, mut whole) = (Fft2::new(n, active), Fft2::new(n, active), Fft2::new(n, active));
-            let phys: Vec<f64> = (0..n * n).map(|i| ((i * 37 % 23) as f64 - 11.0) / 7.0).collect();
-            let mut spec = vec![Complex64::default(); whole.spectral_len()];
-            whole.forward(&phys, &mut spec);
-            let mut spec2 = spec.clone();
-            let (mut one, mut two) = (vec![0.0; n * n], vec![0.0; n * n]);
-            whole.inverse_destroying(&mut spec, &mut one);
-            // Each half on its own thread, as the solver runs it with two.
-            inverse_destroying_split(&mut a, &mut b, &mut spec2, &mut two, true);
-            assert!(one.iter().zip(&two).all(|(x, y)| x.to_bits() == y.to_bits()), "n {n}");
-        }
     }
 }

@@ -16,12 +16,13 @@
 //! Adjoint convention: every field, including a cotangent, is a real physical field, stored as
 //! its half spectrum; the inner product is `sum_x f(x) g(x)`. The adjoint of a Fourier multiplier
 //! with symbol `d(k)` is then the multiplier `conj(d(k))`, the adjoint of a pointwise product is
-//! itself, so [`Kolmogorov::step_vjp`] mirrors [`Kolmogorov::step`] line by line.
+//! itself, so [`Kolmogorov::step_vjp`] mirrors [`Kolmogorov::step`] line by line (the nonlinear
+//! term's adjoint folded into two products by `div u = 0`).
 
 use realfft::num_complex::Complex64 as C;
 use thiserror::Error;
 
-use super::fft2::{inner, inverse_destroying_split, ky_of, Fft2};
+use super::fft2::{inner, ky_of, Fft2};
 
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SpectralError {
@@ -60,24 +61,20 @@ struct Fields {
     wy: Vec<f64>,
 }
 
-/// `rayon::join(a, b)`, or `a` then `b` on the calling thread when the pool has one thread: a
-/// join from outside the pool moves both halves to a worker and back, which costs more than the
-/// transforms at small N when nothing can run beside them. Either way each half runs the same
-/// code on its own buffers, so the results are bitwise the same.
-fn join(a: impl FnOnce() + Send, b: impl FnOnce() + Send) {
-    if rayon::current_num_threads() == 1 {
+/// Smallest grid whose transforms [`join`] runs on two threads.
+const PARALLEL_MIN_N: usize = 256;
+
+/// `rayon::join(a, b)` on grids of at least [`PARALLEL_MIN_N`] points a side in a pool of more
+/// than one thread, else `a` then `b` on the calling thread: a join from outside the pool moves
+/// both halves to a worker and back, which costs more than the two halves save on smaller grids
+/// (`hgym bench kolmogorov --threads 1` is faster than `--threads 2` there). Either way each half
+/// runs the same code on its own buffers, so the results are bitwise the same.
+fn join(n: usize, a: impl FnOnce() + Send, b: impl FnOnce() + Send) {
+    if n < PARALLEL_MIN_N || rayon::current_num_threads() == 1 {
         a();
         b();
     } else {
         rayon::join(a, b);
-    }
-}
-
-/// Row `y` of the product `a b` of two `n x n` fields, for [`Fft2::forward_rows`].
-fn product_rows<'a>(a: &'a [f64], b: &'a [f64], n: usize) -> impl FnMut(usize, &mut [f64]) + 'a {
-    move |y, row| {
-        let r = y * n..(y + 1) * n;
-        row.iter_mut().zip(&a[r.clone()]).zip(&b[r]).for_each(|((p, a), b)| *p = a * b);
     }
 }
 
@@ -101,7 +98,8 @@ struct Work {
     stage: [Fields; 4],
     bar: [Vec<C>; 5],
     fbar: Vec<C>,
-    mu: Vec<f64>,
+    /// `grad mu` of a VJP's cotangent, physical.
+    mu: [Vec<f64>; 2],
 }
 
 pub struct Kolmogorov {
@@ -207,7 +205,7 @@ impl Kolmogorov {
                 stage: [Fields::new(m), Fields::new(m), Fields::new(m), Fields::new(m)],
                 bar: [z(), z(), z(), z(), z()],
                 fbar: z(),
-                mu: vec![0.0; m],
+                mu: [vec![0.0; m], vec![0.0; m]],
             },
             cfg,
         })
@@ -357,6 +355,7 @@ impl Kolmogorov {
         // Two independent pairs of transforms, one per thread (each transform is computed the
         // same way on either, so results do not depend on the thread count).
         join(
+            self.n,
             || {
                 fa.inverse_destroying(s0, u);
                 fa.inverse_destroying(s1, v);
@@ -460,34 +459,57 @@ impl Kolmogorov {
         Ok(())
     }
 
-    /// `out = J(w)^T lambda` for the nonlinear term at the stage whose fields sit in `slot`:
-    /// with `mu = P lambda`, `out = i [k_y/k^2 F(omega_x mu) + k_x F(u mu) - k_x/k^2 F(omega_y mu)
-    /// + k_y F(v mu)]` (the conjugate symbols of `-P (u omega_x + v omega_y)`'s linearisation).
+    /// `out = J(w)^T lambda` for the nonlinear term `-P F(u omega_x + v omega_y)` at the stage
+    /// whose fields sit in `slot`. Its conjugate symbols give, with `mu = P lambda`,
+    /// `i [k_y/k^2 F(omega_x mu) - k_x/k^2 F(omega_y mu) + k_x F(u mu) + k_y F(v mu)]`; since
+    /// `i k F(f) = F(grad f)` and `div u = 0`, the pairs fold into
+    ///
+    /// `out = F(omega_x mu_y - omega_y mu_x) / k^2 + F(u mu_x + v mu_y)`,
+    ///
+    /// two inverse and two forward transforms instead of one and four. The folding is exact on
+    /// the dealiased modes: every field here is band-limited to `k_max` (the solver's states are),
+    /// so the products' spectra up to `k_max` carry no aliases.
     fn nonlinear_vjp(&mut self, slot: usize, lambda: &[C], out: &mut [C]) {
-        let s = &mut self.w.spec[0];
-        for i in 0..self.act {
-            s[i] = lambda[i] * self.mask[i];
-        }
-        inverse_destroying_split(&mut self.fft, &mut self.fft_b, s, &mut self.w.mu, rayon::current_num_threads() > 1);
-        let f = &self.w.stage[slot];
         let [s0, s1, s2, s3] = &mut self.w.spec;
+        for i in 0..self.act {
+            let l = lambda[i] * self.mask[i];
+            let il = C::new(-l.im, l.re);
+            s0[i] = il * self.kx[i];
+            s1[i] = il * self.ky[i];
+        }
+        let f = &self.w.stage[slot];
+        let [mu_x, mu_y] = &mut self.w.mu;
         let (fa, fb) = (&mut self.fft, &mut self.fft_b);
-        let (mu, n) = (&self.w.mu, self.n);
-        let product = |a| product_rows(a, mu, n);
+        join(self.n, || fa.inverse_destroying(s0, mu_x), || fb.inverse_destroying(s1, mu_y));
+        let (mu_x, mu_y, n) = (&*mu_x, &*mu_y, self.n);
+        let rows = move |y: usize| y * n..(y + 1) * n;
         join(
+            self.n,
             || {
-                fa.forward_rows(product(&f.wx), s1);
-                fa.forward_rows(product(&f.u), s2);
+                fa.forward_rows(
+                    |y, row| {
+                        let (wx, wy, mx, my) = (&f.wx[rows(y)], &f.wy[rows(y)], &mu_x[rows(y)], &mu_y[rows(y)]);
+                        for ((((p, wx), wy), mx), my) in row.iter_mut().zip(wx).zip(wy).zip(mx).zip(my) {
+                            *p = wx * my - wy * mx;
+                        }
+                    },
+                    s2,
+                )
             },
             || {
-                fb.forward_rows(product(&f.wy), s3);
-                fb.forward_rows(product(&f.v), s0);
+                fb.forward_rows(
+                    |y, row| {
+                        let (u, v, mx, my) = (&f.u[rows(y)], &f.v[rows(y)], &mu_x[rows(y)], &mu_y[rows(y)]);
+                        for ((((p, u), v), mx), my) in row.iter_mut().zip(u).zip(v).zip(mx).zip(my) {
+                            *p = u * mx + v * my;
+                        }
+                    },
+                    s3,
+                )
             },
         );
         for i in 0..self.act {
-            let (kx, ky, ik2) = (self.kx[i], self.ky[i], self.inv_k2[i]);
-            let z = s1[i] * (ky * ik2) + s2[i] * kx - s3[i] * (kx * ik2) + s0[i] * ky;
-            out[i] = C::new(-z.im, z.re);
+            out[i] = s2[i] * self.inv_k2[i] + s3[i];
         }
         out[self.act..].iter_mut().for_each(|c| *c = C::default());
     }
