@@ -22,7 +22,7 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 use wide::f32x8;
 
 use super::super::collision::{Relax, OMEGA_BULK, OP_BGK};
-use super::super::kernel::prefetch;
+use super::super::kernel::{prefetch, stream_aligned};
 use super::lattice::Lattice3;
 
 /// Density deviation and momentum: `drho = sum g_i`, `j = sum c_i g_i`.
@@ -270,8 +270,35 @@ pub fn collide<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool,
     collide_lanes::<f32, Q, L, OP, FORCED, LES>(g, relax, f)
 }
 
-/// Nodes per vector block: one AVX register of f32.
-const LANES: usize = 8;
+/// A block of nodes the bulk loop collides at once: [`Lanes`] arithmetic on `LANES` nodes,
+/// loaded from and stored to the first `LANES` floats of a slice. `wide::f32x8` (AVX2) on every
+/// machine; `F32x16` (AVX-512F, [`super::avx512`]) where the CPU has it.
+pub trait Block: Lanes {
+    const LANES: usize;
+    fn load(s: &[f32]) -> Self;
+    fn store(self, d: &mut [f32]);
+    /// Copies `src` to `dst` with non-temporal stores (`dst` 32-byte aligned, a multiple of 8
+    /// floats long: see [`stream_aligned`]).
+    #[inline(always)]
+    fn stream(dst: &mut [f32], src: &[f32]) {
+        stream_aligned(dst, src)
+    }
+}
+
+impl Block for f32x8 {
+    const LANES: usize = 8;
+    #[inline(always)]
+    fn load(s: &[f32]) -> Self {
+        f32x8::new(s[..8].try_into().expect("a slice of 8"))
+    }
+    #[inline(always)]
+    fn store(self, d: &mut [f32]) {
+        d[..8].copy_from_slice(&self.to_array());
+    }
+}
+
+/// The widest [`Block::LANES`]: room for a block in a plain array.
+const MAX_LANES: usize = 16;
 
 /// The pulls across a periodic x axis, which a row's source slices do not hold: `first[i]` for
 /// the directions with `c_x = 1` at the row's first node, `last[i]` for `c_x = -1` at its last.
@@ -289,14 +316,14 @@ pub const CHUNK: usize = 128;
 
 /// [`collide`] for `m <= CHUNK` consecutive nodes of a row of `n`, from node `x0` on: node `k`
 /// reads direction `i` from `src[i][k]` (or from `ends` at the row's two ends) and writes it to
-/// `out[i][k]`, in blocks of [`LANES`] nodes ([`collide_lanes`] on `wide::f32x8`); a last,
-/// partial block is padded with rest-state values that are computed and dropped. The chunk goes
-/// through a buffer in L1 rather than straight to the rows: full cache lines, one direction
-/// after the other, are what the non-temporal stores need (32-byte stores to 19 or 27 rows at
-/// once measured 10-15 % slower, with ordinary stores too).
+/// `out[i][k]`, in blocks of `B::LANES` nodes ([`collide_lanes`] on `B`); a last, partial block
+/// is padded with zeros (the rest state) that are computed and dropped. The chunk goes through a
+/// buffer in L1 rather than straight to the rows: full cache lines, one direction after the
+/// other, are what the non-temporal stores need (32-byte stores to 19 or 27 rows at once
+/// measured 10-15 % slower, with ordinary stores too).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-pub fn collide_chunk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
+pub fn collide_chunk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
     src: &[&[f32]; Q],
     x0: usize,
     m: usize,
@@ -306,35 +333,36 @@ pub fn collide_chunk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED:
     relax: Relax,
     f: [f32; 3],
 ) {
+    let lanes = B::LANES;
     let mut x = 0;
-    while x + LANES <= m {
-        let mut g = [f32x8::ZERO; Q];
+    while x + lanes <= m {
+        let mut g = [B::splat(0.0); Q];
         for i in 0..Q {
-            let v: [f32; LANES] = src[i][x..x + LANES].try_into().expect("a block is LANES long");
-            g[i] = f32x8::new(v);
+            g[i] = B::load(&src[i][x..]);
             prefetch(src[i].as_ptr().wrapping_add(x + PREFETCH_AHEAD));
         }
-        if x0 + x == 0 || x0 + x + LANES == n {
-            patch_ends::<Q, L>(&mut g, x0 + x, LANES, n, ends);
+        if x0 + x == 0 || x0 + x + lanes == n {
+            patch_ends::<B, Q, L>(&mut g, x0 + x, lanes, n, ends);
         }
-        collide_lanes::<f32x8, Q, L, OP, FORCED, LES>(&mut g, relax, f);
+        collide_lanes::<B, Q, L, OP, FORCED, LES>(&mut g, relax, f);
         for i in 0..Q {
-            out[i][x..x + LANES].copy_from_slice(&g[i].to_array());
+            g[i].store(&mut out[i][x..]);
         }
-        x += LANES;
+        x += lanes;
     }
     if x < m {
         let len = m - x;
-        let mut g = [f32x8::ZERO; Q];
+        let mut g = [B::splat(0.0); Q];
+        let mut v = [0.0f32; MAX_LANES];
         for i in 0..Q {
-            let mut v = [0.0f32; LANES];
             v[..len].copy_from_slice(&src[i][x..m]);
-            g[i] = f32x8::new(v);
+            g[i] = B::load(&v);
         }
-        patch_ends::<Q, L>(&mut g, x0 + x, len, n, ends);
-        collide_lanes::<f32x8, Q, L, OP, FORCED, LES>(&mut g, relax, f);
+        patch_ends::<B, Q, L>(&mut g, x0 + x, len, n, ends);
+        collide_lanes::<B, Q, L, OP, FORCED, LES>(&mut g, relax, f);
         for i in 0..Q {
-            out[i][x..m].copy_from_slice(&g[i].to_array()[..len]);
+            g[i].store(&mut v);
+            out[i][x..m].copy_from_slice(&v[..len]);
         }
     }
 }
@@ -343,7 +371,7 @@ pub fn collide_chunk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED:
 /// node for the directions that pull across `x = 0` (`c_x = 1`), the last node's lane for those
 /// that pull across the other end (`c_x = -1`).
 #[inline(always)]
-fn patch_ends<const Q: usize, L: Lattice3<Q>>(g: &mut [f32x8; Q], x: usize, len: usize, m: usize, ends: Ends<Q>) {
+fn patch_ends<B: Block, const Q: usize, L: Lattice3<Q>>(g: &mut [B; Q], x: usize, len: usize, m: usize, ends: Ends<Q>) {
     for i in 0..Q {
         let c_x = L::C_REF[i][0];
         let lane = match (c_x, ends.first, ends.last) {
@@ -352,9 +380,10 @@ fn patch_ends<const Q: usize, L: Lattice3<Q>>(g: &mut [f32x8; Q], x: usize, len:
             _ => None,
         };
         if let Some((l, v)) = lane {
-            let mut a = g[i].to_array();
+            let mut a = [0.0f32; MAX_LANES];
+            g[i].store(&mut a);
             a[l] = v;
-            g[i] = f32x8::new(a);
+            g[i] = B::load(&a);
         }
     }
 }
@@ -526,31 +555,55 @@ mod tests {
         all::<27, D3q27>();
     }
 
-    /// Eight different nodes collided as one vector block give, lane by lane, what each gives
-    /// alone.
-    #[test]
-    fn a_block_is_bitwise_its_nodes() {
-        fn check<const Q: usize, L: Lattice3<Q>>() {
-            let relax = Relax::new(0.56, 0.17);
-            let f = [2e-4, -1e-4, 3e-4];
-            let nodes: Vec<[f32; Q]> = (0..LANES as u64).map(state::<Q, L>).collect();
-            let mut block: [f32x8; Q] = std::array::from_fn(|i| f32x8::new(std::array::from_fn(|l| nodes[l][i])));
-            collide_lanes::<f32x8, Q, L, OP_REG, true, true>(&mut block, relax, f);
-            for (l, node) in nodes.iter().enumerate() {
-                let mut g = *node;
-                collide::<Q, L, OP_REG, true, true>(&mut g, relax, f);
-                for i in 0..Q {
-                    assert_eq!(
-                        block[i].to_array()[l].to_bits(),
-                        g[i].to_bits(),
-                        "{} lane {l} direction {i}",
-                        L::NAME
-                    );
-                }
+    /// Different nodes collided as one vector block give, lane by lane, what each gives alone,
+    /// for every operator and both block widths (16 lanes only where the CPU has AVX-512F).
+    fn block_is_its_nodes<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>() {
+        let relax = Relax::new(0.56, if LES { 0.17 } else { 0.0 });
+        let f = [2e-4, -1e-4, 3e-4];
+        let nodes: Vec<[f32; Q]> = (0..B::LANES as u64).map(state::<Q, L>).collect();
+        let mut block = [B::splat(0.0); Q];
+        for i in 0..Q {
+            let lanes: Vec<f32> = nodes.iter().map(|g| g[i]).collect();
+            block[i] = B::load(&lanes);
+        }
+        collide_lanes::<B, Q, L, OP, FORCED, LES>(&mut block, relax, f);
+        for (l, node) in nodes.iter().enumerate() {
+            let mut g = *node;
+            collide::<Q, L, OP, FORCED, LES>(&mut g, relax, f);
+            for i in 0..Q {
+                let mut out = vec![0.0f32; B::LANES];
+                block[i].store(&mut out);
+                assert_eq!(
+                    out[l].to_bits(),
+                    g[i].to_bits(),
+                    "{} {} lanes, op {OP} forced {FORCED} les {LES}: lane {l} direction {i}",
+                    L::NAME,
+                    B::LANES
+                );
             }
         }
-        check::<19, D3q19>();
-        check::<27, D3q27>();
+    }
+
+    fn blocks_are_their_nodes<B: Block>() {
+        fn all<B: Block, const Q: usize, L: Lattice3<Q>>() {
+            block_is_its_nodes::<B, Q, L, OP_BGK, false, false>();
+            block_is_its_nodes::<B, Q, L, OP_BGK, true, false>();
+            block_is_its_nodes::<B, Q, L, OP_REG, false, false>();
+            block_is_its_nodes::<B, Q, L, OP_REG, true, true>();
+        }
+        all::<B, 19, D3q19>();
+        all::<B, 27, D3q27>();
+    }
+
+    #[test]
+    fn a_block_is_bitwise_its_nodes() {
+        blocks_are_their_nodes::<f32x8>();
+        #[cfg(target_arch = "x86_64")]
+        if super::super::avx512::available() {
+            blocks_are_their_nodes::<super::super::avx512::F32x16>();
+        } else {
+            eprintln!("no AVX-512F on this CPU: the 16-lane block is not tested");
+        }
     }
 
     #[test]

@@ -11,11 +11,12 @@
 //! link into a body) then run the general path and overwrite their values.
 
 use rayon::prelude::*;
+use wide::f32x8;
 
 use super::super::collision::Relax;
 pub(crate) use super::super::kernel::Special;
-use super::super::kernel::{nt_rows_possible, store_fence, stream_aligned};
-use super::collision::{collide, collide_chunk, moments, Ends, CHUNK};
+use super::super::kernel::{nt_rows_possible, store_fence};
+use super::collision::{collide, collide_chunk, moments, Block, Ends, CHUNK};
 use super::lattice::Lattice3;
 use super::sides::{face_source, face_value, face_value_planned, plan_face_pull, Faces};
 use super::sponge::Layers;
@@ -317,7 +318,7 @@ pub(crate) fn plan_pulls<const Q: usize, L: Lattice3<Q>>(c: &Ctx, p: [usize; 3],
 /// otherwise the values at `x = 0` and `nx - 1` are wrong (their pulls run into the neighbouring
 /// rows) and are overwritten by the specials.
 #[inline(always)]
-fn bulk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
+fn bulk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
     c: &Ctx,
     src: &[f32],
     src_ext: &[f32],
@@ -336,6 +337,8 @@ fn bulk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const 
         let (row, si) = c.row_source::<Q, L>(src_ext, y, z, i);
         s[i] = si;
         if periodic_x {
+            // The next row's end pulls are the same direction's values one source row on
+            // (`nx` later, unless y wraps): asked for now, they are in cache when it runs.
             let c_x = L::C_REF[i][0];
             if c_x == 1 {
                 first[i] = src[row + nx - 1];
@@ -361,13 +364,13 @@ fn bulk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const 
         for i in 0..Q {
             t[i] = &s[i][c0..c1];
         }
-        collide_chunk::<Q, L, OP, FORCED, LES>(&t, c0, c1 - c0, nx, ends, buf, c.relax, c.force);
+        collide_chunk::<B, Q, L, OP, FORCED, LES>(&t, c0, c1 - c0, nx, ends, buf, c.relax, c.force);
         c.layers.chunk(buf, c0, c1 - c0, y, z);
         for (i, b) in buf.iter().enumerate() {
             let row = (i * ny + y) * nx;
             let dst = &mut out[row + c0..row + c1];
             if stream {
-                stream_aligned(dst, &b[..c1 - c0]);
+                B::stream(dst, &b[..c1 - c0]);
             } else {
                 dst.copy_from_slice(&b[..c1 - c0]);
             }
@@ -379,9 +382,10 @@ fn bulk<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const 
     }
 }
 
-/// Plane `z` of the destination (`Q ny nx` values): each row's bulk loop, then its specials.
+/// Plane `z` of the destination (`Q ny nx` values): each row's bulk loop on blocks of `B`,
+/// then its specials.
 #[inline(always)]
-pub(crate) fn plane<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
+fn plane<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
     c: &Ctx,
     src: &[f32],
     src_ext: &[f32],
@@ -393,7 +397,7 @@ pub(crate) fn plane<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: 
     for y in 0..ny {
         let r = z * ny + y;
         if nx >= 3 && c.row_bulk[r] {
-            bulk::<Q, L, OP, FORCED, LES>(c, src, src_ext, y, z, out, &mut buf);
+            bulk::<B, Q, L, OP, FORCED, LES>(c, src, src_ext, y, z, out, &mut buf);
         }
         let first = c.row_start[r] as usize;
         let specials = &c.specials[first..c.row_start[r + 1] as usize];
@@ -416,4 +420,47 @@ pub(crate) fn plane<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: 
             }
         }
     }
+}
+
+/// [`plane`] on blocks of 8 nodes (`wide::f32x8`, AVX2), whatever the CPU.
+pub(crate) fn plane_narrow<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
+    c: &Ctx,
+    src: &[f32],
+    src_ext: &[f32],
+    z: usize,
+    out: &mut [f32],
+) {
+    plane::<f32x8, Q, L, OP, FORCED, LES>(c, src, src_ext, z, out)
+}
+
+/// [`plane`] on the widest blocks the CPU runs: 16 nodes with AVX-512F, else 8. Both give
+/// bitwise the same populations (see [`super::avx512`]).
+pub(crate) fn plane_widest<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
+    c: &Ctx,
+    src: &[f32],
+    src_ext: &[f32],
+    z: usize,
+    out: &mut [f32],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if super::avx512::available() {
+        // SAFETY: the CPU has AVX-512F (checked just above), the only feature `plane_avx512`
+        // enables.
+        return unsafe { plane_avx512::<Q, L, OP, FORCED, LES>(c, src, src_ext, z, out) };
+    }
+    plane_narrow::<Q, L, OP, FORCED, LES>(c, src, src_ext, z, out)
+}
+
+/// [`plane`] on 16-node blocks, compiled with AVX-512F so that the block arithmetic inlined into
+/// it runs on `zmm` registers (32 of them: the collision's temporaries no longer spill).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn plane_avx512<const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
+    c: &Ctx,
+    src: &[f32],
+    src_ext: &[f32],
+    z: usize,
+    out: &mut [f32],
+) {
+    plane::<super::avx512::F32x16, Q, L, OP, FORCED, LES>(c, src, src_ext, z, out)
 }

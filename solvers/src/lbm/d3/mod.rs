@@ -17,6 +17,8 @@
 // equations do.
 #![allow(clippy::needless_range_loop)]
 
+#[cfg(target_arch = "x86_64")]
+mod avx512;
 mod collision;
 mod kernel;
 pub mod lattice;

@@ -8,7 +8,7 @@ use super::super::collision::{Collision, Relax, OP_BGK, OP_REG};
 use super::super::error::LbmError;
 use super::super::solver::STREAM_STORES_ABOVE_BYTES;
 use super::collision::{collide, equilibrium, moments};
-use super::kernel::{bouzidi, gather, index, plan_pulls, plane, Ctx, FaceMoments, FacePull, Link, Special, PAD};
+use super::kernel::{bouzidi, gather, index, plan_pulls, plane_narrow, plane_widest, Ctx, FaceMoments, FacePull, Link, Special, PAD};
 use super::lattice::Lattice3;
 use super::sides::{Face, Faces};
 use super::sponge::{apply_plane, Layers, Sponge3, Sponge3Plan};
@@ -102,9 +102,14 @@ macro_rules! monomorphised {
     };
 }
 
-/// Selects the kernel monomorphised for the operator, forcing and subgrid model.
-fn plane_fn<const Q: usize, L: Lattice3<Q>>(collision: Collision, forced: bool, les: bool) -> PlaneFn {
-    monomorphised!(plane, collision, forced, les)
+/// Selects the kernel monomorphised for the operator, forcing and subgrid model, on the widest
+/// vector blocks the CPU runs or (`narrow`) on 8-node blocks.
+fn plane_fn<const Q: usize, L: Lattice3<Q>>(collision: Collision, forced: bool, les: bool, narrow: bool) -> PlaneFn {
+    if narrow {
+        monomorphised!(plane_narrow, collision, forced, les)
+    } else {
+        monomorphised!(plane_widest, collision, forced, les)
+    }
 }
 
 /// What the blow-up scan found at a node.
@@ -188,6 +193,8 @@ pub struct Lbm3<const Q: usize, L: Lattice3<Q>> {
     body_forces: Vec<[f64; 3]>,
     sponges: Vec<Sponge3Plan>,
     time: u64,
+    /// Run the bulk on 8-node blocks even where the CPU has 16 ([`Lbm3::use_narrow_blocks`]).
+    narrow_blocks: bool,
     _lattice: std::marker::PhantomData<L>,
 }
 
@@ -472,6 +479,7 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             body_forces: vec![[0.0; 3]; bodies.len()],
             time: 0,
             cfg,
+            narrow_blocks: false,
             _lattice: std::marker::PhantomData,
         })
     }
@@ -820,7 +828,12 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
 
     /// Advances one time step (every rank together). Allocates nothing.
     pub fn step(&mut self) -> Result<(), LbmError> {
-        let kernel = plane_fn::<Q, L>(self.cfg.collision, self.cfg.body_force != [0.0; 3], self.cfg.smagorinsky > 0.0);
+        let kernel = plane_fn::<Q, L>(
+            self.cfg.collision,
+            self.cfg.body_force != [0.0; 3],
+            self.cfg.smagorinsky > 0.0,
+            self.narrow_blocks,
+        );
         self.face_moments.fill::<Q, L>(self.cfg.n, &self.f);
         let ctx = ctx::<Q>(
             &self.cfg,
@@ -840,6 +853,13 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
         Self::link_forces_parallel(&ctx, src, &self.link_bin, &mut self.link_force, &mut self.partial);
         std::mem::swap(&mut self.f, &mut self.f_next);
         self.finish_step()
+    }
+
+    /// Runs the bulk loop on 8-node blocks (AVX2) even on a CPU with AVX-512F, for tests: both
+    /// widths give bitwise the same populations.
+    #[doc(hidden)]
+    pub fn use_narrow_blocks(&mut self) {
+        self.narrow_blocks = true;
     }
 
     /// Slow oracle for tests: every node through the general path (gather, bounce-back,
