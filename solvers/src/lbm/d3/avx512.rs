@@ -6,9 +6,9 @@
 //! the same populations; which one runs is decided at run time and changes no result.
 //!
 //! Soundness: the methods of [`F32x16`] execute AVX-512F instructions. The type is private to
-//! the 3D module and only [`super::kernel`]'s `plane_avx512` uses it, which runs only after
-//! [`available`] found the feature (tested by `avx512_blocks_match_avx2_and_scalar` in
-//! `collision.rs` and the kernel-against-oracle tests at both widths).
+//! the 3D module; outside this file only [`super::kernel`]'s `plane_avx512` and a unit test of
+//! `collision.rs` (`a_block_is_bitwise_its_nodes`) use it, both only after [`available`] found
+//! the feature. The kernel is tested against the oracle bitwise at both widths (`exact3d`).
 
 use core::arch::x86_64::{
     __m512, _mm512_add_ps, _mm512_div_ps, _mm512_loadu_ps, _mm512_mul_ps, _mm512_set1_ps, _mm512_setzero_ps, _mm512_sqrt_ps,

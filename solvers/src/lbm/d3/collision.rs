@@ -316,11 +316,12 @@ pub const CHUNK: usize = 128;
 
 /// [`collide`] for `m <= CHUNK` consecutive nodes of a row of `n`, from node `x0` on: node `k`
 /// reads direction `i` from `src[i][k]` (or from `ends` at the row's two ends) and writes it to
-/// `out[i][k]`, in blocks of `B::LANES` nodes ([`collide_lanes`] on `B`); a last, partial block
-/// is padded with zeros (the rest state) that are computed and dropped. The chunk goes through a
-/// buffer in L1 rather than straight to the rows: full cache lines, one direction after the
-/// other, are what the non-temporal stores need (32-byte stores to 19 or 27 rows at once
-/// measured 10-15 % slower, with ordinary stores too).
+/// `out[i][k]`, in blocks of `B::LANES` nodes ([`collide_lanes`] on `B`), what is left in blocks
+/// of 8 (so a 16-lane `B` wastes no more lanes on a short row than `f32x8` does), and a last,
+/// partial block padded with zeros (the rest state) that are computed and dropped. The chunk
+/// goes through a buffer in L1 rather than straight to the rows: full cache lines, one direction
+/// after the other, are what the non-temporal stores need (32-byte stores to 19 or 27 rows at
+/// once measured 10-15 % slower, with ordinary stores too).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub fn collide_chunk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
@@ -333,8 +334,40 @@ pub fn collide_chunk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, con
     relax: Relax,
     f: [f32; 3],
 ) {
+    let x = full_blocks::<B, Q, L, OP, FORCED, LES>(src, 0, x0, m, n, ends, out, relax, f);
+    let x = full_blocks::<f32x8, Q, L, OP, FORCED, LES>(src, x, x0, m, n, ends, out, relax, f);
+    if x < m {
+        let len = m - x;
+        let mut g = [f32x8::ZERO; Q];
+        let mut v = [0.0f32; 8];
+        for i in 0..Q {
+            v[..len].copy_from_slice(&src[i][x..m]);
+            g[i] = f32x8::new(v);
+        }
+        patch_ends::<f32x8, Q, L>(&mut g, x0 + x, len, n, ends);
+        collide_lanes::<f32x8, Q, L, OP, FORCED, LES>(&mut g, relax, f);
+        for i in 0..Q {
+            out[i][x..m].copy_from_slice(&g[i].to_array()[..len]);
+        }
+    }
+}
+
+/// The whole blocks of `B::LANES` nodes of [`collide_chunk`] from chunk node `x` on; returns
+/// where they end.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn full_blocks<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
+    src: &[&[f32]; Q],
+    mut x: usize,
+    x0: usize,
+    m: usize,
+    n: usize,
+    ends: Ends<Q>,
+    out: &mut [[f32; CHUNK]; Q],
+    relax: Relax,
+    f: [f32; 3],
+) -> usize {
     let lanes = B::LANES;
-    let mut x = 0;
     while x + lanes <= m {
         let mut g = [B::splat(0.0); Q];
         for i in 0..Q {
@@ -350,21 +383,7 @@ pub fn collide_chunk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, con
         }
         x += lanes;
     }
-    if x < m {
-        let len = m - x;
-        let mut g = [B::splat(0.0); Q];
-        let mut v = [0.0f32; MAX_LANES];
-        for i in 0..Q {
-            v[..len].copy_from_slice(&src[i][x..m]);
-            g[i] = B::load(&v);
-        }
-        patch_ends::<B, Q, L>(&mut g, x0 + x, len, n, ends);
-        collide_lanes::<B, Q, L, OP, FORCED, LES>(&mut g, relax, f);
-        for i in 0..Q {
-            g[i].store(&mut v);
-            out[i][x..m].copy_from_slice(&v[..len]);
-        }
-    }
+    x
 }
 
 /// Puts [`Ends`] into the block of `len` nodes at `x` of a row of `m`: lane 0 of the row's first

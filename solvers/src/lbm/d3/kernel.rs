@@ -337,8 +337,6 @@ fn bulk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bo
         let (row, si) = c.row_source::<Q, L>(src_ext, y, z, i);
         s[i] = si;
         if periodic_x {
-            // The next row's end pulls are the same direction's values one source row on
-            // (`nx` later, unless y wraps): asked for now, they are in cache when it runs.
             let c_x = L::C_REF[i][0];
             if c_x == 1 {
                 first[i] = src[row + nx - 1];
