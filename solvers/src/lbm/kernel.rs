@@ -220,7 +220,7 @@ fn bulk_row_streamed<const OP: u8, const FORCED: bool, const LES: bool>(c: &Kern
             if c1 == nx {
                 b[len - 1] = 0.0;
             }
-            stream_aligned(&mut row[i * nx + c0..i * nx + c1], &b[..len]);
+            stream_lines(&mut row[i * nx + c0..i * nx + c1], &b[..len]);
         }
         c0 = c1;
     }
@@ -251,6 +251,48 @@ pub(crate) fn stream_aligned(dst: &mut [f32], src: &[f32]) {
     }
     #[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
     dst.copy_from_slice(src);
+}
+
+/// Whether this CPU runs AVX-512F (detected once by `std`, then a cached load).
+#[cfg(target_arch = "x86_64")]
+#[inline]
+pub(crate) fn avx512_available() -> bool {
+    std::arch::is_x86_feature_detected!("avx512f")
+}
+
+/// `dst.copy_from_slice(src)` with non-temporal stores: a whole cache line per store
+/// (`vmovntps zmm`) where the CPU has AVX-512F and `dst` starts on a line and holds whole ones,
+/// otherwise [`stream_aligned`]'s half lines (same conditions on `dst` as there).
+#[inline]
+pub(crate) fn stream_lines(dst: &mut [f32], src: &[f32]) {
+    #[cfg(target_arch = "x86_64")]
+    if dst.len().is_multiple_of(16) && (dst.as_ptr() as usize).is_multiple_of(64) && avx512_available() {
+        // SAFETY: the CPU has AVX-512F (checked just above), the only feature
+        // `stream_lines_avx512` enables.
+        return unsafe { stream_lines_avx512(dst, src) };
+    }
+    stream_aligned(dst, src)
+}
+
+/// [`stream_lines`] on a CPU with AVX-512F, `dst` 64-byte aligned and a multiple of 16 long.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn stream_lines_avx512(dst: &mut [f32], src: &[f32]) {
+    use core::arch::x86_64::{_mm512_loadu_ps, _mm512_stream_ps};
+    assert_eq!(dst.len(), src.len());
+    assert!(
+        dst.len().is_multiple_of(16) && (dst.as_ptr() as usize).is_multiple_of(64),
+        "stream_lines_avx512: unaligned destination"
+    );
+    for (d, s) in dst.chunks_exact_mut(16).zip(src.chunks_exact(16)) {
+        // SAFETY: `d` and `s` are 16 floats each (`chunks_exact` of equal-length slices whose
+        // length is a multiple of 16), all the load reads and the store writes; `d` is 64-byte
+        // aligned because `dst` is (asserted above) and every chunk starts a multiple of 64
+        // bytes after it; AVX-512F is enabled on this function, which its caller runs only
+        // where the CPU has it. The non-temporal store is ordered by `store_fence` before
+        // anything reads it.
+        unsafe { _mm512_stream_ps(d.as_mut_ptr(), _mm512_loadu_ps(s.as_ptr())) };
+    }
 }
 
 /// Asks for the cache line holding `p` (`prefetcht0`). A hint: it never faults and changes no
@@ -409,5 +451,24 @@ mod tests {
         prefetch(usize::MAX as *const f32);
         prefetch(v.as_ptr().wrapping_add(1 << 40));
         assert_eq!(v, [1.0; 4]);
+    }
+
+    /// Whole-line and half-line non-temporal copies give the source exactly, and touch nothing
+    /// outside the destination: a line-aligned destination of whole lines, one of half lines,
+    /// and one starting half a line in.
+    #[test]
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    fn stream_lines_copies_exactly() {
+        let mut dst = crate::lbm::aligned::AlignedVec::zeros(96);
+        let src: Vec<f32> = (0..96).map(|k| k as f32 * 0.5 - 7.0).collect();
+        for (start, len) in [(0, 96), (0, 40), (8, 64)] {
+            dst.fill(-1.0);
+            stream_lines(&mut dst[start..start + len], &src[..len]);
+            store_fence();
+            for (k, v) in dst.iter().enumerate() {
+                let want = if (start..start + len).contains(&k) { src[k - start] } else { -1.0 };
+                assert_eq!(v.to_bits(), want.to_bits(), "start {start} len {len}: element {k}");
+            }
+        }
     }
 }

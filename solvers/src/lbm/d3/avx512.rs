@@ -7,23 +7,17 @@
 //!
 //! Soundness: the methods of [`F32x16`] execute AVX-512F instructions. The type is private to
 //! the 3D module; outside this file only [`super::kernel`]'s `plane_avx512` and a unit test of
-//! `collision.rs` (`a_block_is_bitwise_its_nodes`) use it, both only after [`available`] found
-//! the feature. The kernel is tested against the oracle bitwise at both widths (`exact3d`).
+//! `collision.rs` (`a_block_is_bitwise_its_nodes`) use it, both only after
+//! [`avx512_available`](super::super::kernel::avx512_available) found the feature. The kernel
+//! is tested against the oracle bitwise at both widths (`exact3d`).
 
 use core::arch::x86_64::{
     __m512, _mm512_add_ps, _mm512_div_ps, _mm512_loadu_ps, _mm512_mul_ps, _mm512_set1_ps, _mm512_setzero_ps, _mm512_sqrt_ps,
-    _mm512_storeu_ps, _mm512_stream_ps, _mm512_sub_ps,
+    _mm512_storeu_ps, _mm512_sub_ps,
 };
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-use super::super::kernel::stream_aligned;
 use super::collision::{Block, Lanes};
-
-/// Whether this CPU runs AVX-512F (detected once by `std`, then a cached load).
-#[inline]
-pub(crate) fn available() -> bool {
-    std::arch::is_x86_feature_detected!("avx512f")
-}
 
 /// Sixteen f32 lanes in one AVX-512 register.
 #[derive(Clone, Copy)]
@@ -86,22 +80,5 @@ impl Block for F32x16 {
         // SAFETY: `d` holds 16 floats (the slicing above panics otherwise), all the unaligned
         // store writes, and it is borrowed mutably; AVX-512F as in the module's soundness note.
         unsafe { _mm512_storeu_ps(d.as_mut_ptr(), self.0) }
-    }
-    /// Whole cache lines per store (`vmovntps zmm`) where `dst` starts on one and holds whole
-    /// ones; otherwise [`stream_aligned`]'s half lines.
-    #[inline(always)]
-    fn stream(dst: &mut [f32], src: &[f32]) {
-        assert_eq!(dst.len(), src.len());
-        if !dst.len().is_multiple_of(16) || !(dst.as_ptr() as usize).is_multiple_of(64) {
-            return stream_aligned(dst, src);
-        }
-        for (d, s) in dst.chunks_exact_mut(16).zip(src.chunks_exact(16)) {
-            // SAFETY: `d` and `s` are 16 floats each (`chunks_exact` of equal-length slices whose
-            // length is a multiple of 16), all the load reads and the store writes; `d` is
-            // 64-byte aligned because `dst` is (checked above) and every chunk starts a multiple
-            // of 64 bytes after it. The non-temporal store is ordered by `store_fence` before
-            // anything reads it. AVX-512F as in the module's soundness note.
-            unsafe { _mm512_stream_ps(d.as_mut_ptr(), _mm512_loadu_ps(s.as_ptr())) };
-        }
     }
 }

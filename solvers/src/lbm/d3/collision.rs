@@ -22,7 +22,7 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 use wide::f32x8;
 
 use super::super::collision::{Relax, OMEGA_BULK, OP_BGK};
-use super::super::kernel::{prefetch, stream_aligned};
+use super::super::kernel::prefetch;
 use super::lattice::Lattice3;
 
 /// Density deviation and momentum: `drho = sum g_i`, `j = sum c_i g_i`.
@@ -277,12 +277,6 @@ pub trait Block: Lanes {
     const LANES: usize;
     fn load(s: &[f32]) -> Self;
     fn store(self, d: &mut [f32]);
-    /// Copies `src` to `dst` with non-temporal stores (`dst` 32-byte aligned, a multiple of 8
-    /// floats long: see [`stream_aligned`]).
-    #[inline(always)]
-    fn stream(dst: &mut [f32], src: &[f32]) {
-        stream_aligned(dst, src)
-    }
 }
 
 impl Block for f32x8 {
@@ -618,7 +612,7 @@ mod tests {
     fn a_block_is_bitwise_its_nodes() {
         blocks_are_their_nodes::<f32x8>();
         #[cfg(target_arch = "x86_64")]
-        if super::super::avx512::available() {
+        if super::super::super::kernel::avx512_available() {
             blocks_are_their_nodes::<super::super::avx512::F32x16>();
         } else {
             eprintln!("no AVX-512F on this CPU: the 16-lane block is not tested");

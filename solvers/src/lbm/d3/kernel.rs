@@ -15,7 +15,7 @@ use wide::f32x8;
 
 use super::super::collision::Relax;
 pub(crate) use super::super::kernel::Special;
-use super::super::kernel::{nt_rows_possible, store_fence};
+use super::super::kernel::{nt_rows_possible, store_fence, stream_lines};
 use super::collision::{collide, collide_chunk, moments, Block, Ends, CHUNK};
 use super::lattice::Lattice3;
 use super::sides::{face_source, face_value, face_value_planned, plan_face_pull, Faces};
@@ -368,7 +368,7 @@ fn bulk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bo
             let row = (i * ny + y) * nx;
             let dst = &mut out[row + c0..row + c1];
             if stream {
-                B::stream(dst, &b[..c1 - c0]);
+                stream_lines(dst, &b[..c1 - c0]);
             } else {
                 dst.copy_from_slice(&b[..c1 - c0]);
             }
@@ -441,7 +441,7 @@ pub(crate) fn plane_widest<const Q: usize, L: Lattice3<Q>, const OP: u8, const F
     out: &mut [f32],
 ) {
     #[cfg(target_arch = "x86_64")]
-    if super::avx512::available() {
+    if super::super::kernel::avx512_available() {
         // SAFETY: the CPU has AVX-512F (checked just above), the only feature `plane_avx512`
         // enables.
         return unsafe { plane_avx512::<Q, L, OP, FORCED, LES>(c, src, src_ext, z, out) };
