@@ -16,6 +16,7 @@
 //! one contiguous block; best of `reps` per method, the methods alternating. `make roofline`
 //! runs this beside STREAM's C copy (`benchmarks/stream/copy.c`) and prints the ratio.
 
+use hgym_solvers::lbm::advise_huge_pages;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -55,9 +56,12 @@ pub struct CopyBandwidth {
 pub fn stream_copy_gbs(n: usize, reps: usize) -> CopyBandwidth {
     let threads = rayon::current_num_threads();
     let block = n.div_ceil(threads).max(1);
-    // `vec![0.0; n]` maps zero pages lazily: the first touch happens below, per block.
+    // `vec![0.0; n]` maps zero pages lazily: the first touch happens below, per block. The
+    // arrays ask for huge pages, as the solvers' population arrays do.
     let mut a = vec![0.0f32; n];
     let mut b = vec![0.0f32; n];
+    advise_huge_pages(&a);
+    advise_huge_pages(&b);
     a.par_chunks_mut(block).enumerate().for_each(|(k, c)| {
         for (i, v) in c.iter_mut().enumerate() {
             *v = (k * block + i) as f32;

@@ -28,6 +28,7 @@ pub mod sponge;
 pub mod thermal;
 mod units;
 
+pub use aligned::advise_huge_pages;
 pub use collision::Collision;
 pub use domain::{Edge, Grid, Side, Sides};
 pub use error::LbmError;
