@@ -109,9 +109,16 @@ pub(crate) fn nt_rows_possible(row: &[f32], nx: usize) -> bool {
 
 /// Collides the nodes of a run: node `k` pulls direction `i` from `src[i][k]` and its
 /// post-collision value goes to `dst[i][k]` (slices of one length). The compiler vectorises the
-/// loop at its target's width.
+/// loop at its target's width. With `PREFETCH` (arrays larger than the caches) the run goes in
+/// blocks of 16 nodes, each first asking for the source lines [`PREFETCH_AHEAD`] floats on:
+/// nine read streams plus nine written ones are more than the hardware prefetchers keep ahead
+/// of (D2Q9 4096^2: about 5 % faster, measured interleaved).
 #[inline(always)]
-fn collide_run<const OP: u8, const FORCED: bool, const LES: bool>(c: &KernelCtx, src: [&[f32]; Q], dst: [&mut [f32]; Q]) {
+fn collide_run<const OP: u8, const FORCED: bool, const LES: bool, const PREFETCH: bool>(
+    c: &KernelCtx,
+    src: [&[f32]; Q],
+    dst: [&mut [f32]; Q],
+) {
     let m = dst[0].len();
     let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = src;
     let [d0, d1, d2, d3, d4, d5, d6, d7, d8] = dst;
@@ -138,18 +145,28 @@ fn collide_run<const OP: u8, const FORCED: bool, const LES: bool>(c: &KernelCtx,
         &mut d7[..m],
         &mut d8[..m],
     );
-    for x in 0..m {
-        let mut g = [s0[x], s1[x], s2[x], s3[x], s4[x], s5[x], s6[x], s7[x], s8[x]];
-        collide_les::<OP, FORCED, LES>(&mut g, c.relax, c.fx, c.fy);
-        d0[x] = g[0];
-        d1[x] = g[1];
-        d2[x] = g[2];
-        d3[x] = g[3];
-        d4[x] = g[4];
-        d5[x] = g[5];
-        d6[x] = g[6];
-        d7[x] = g[7];
-        d8[x] = g[8];
+    let mut x0 = 0;
+    while x0 < m {
+        let x1 = if PREFETCH { (x0 + 16).min(m) } else { m };
+        if PREFETCH {
+            for s in [s0, s1, s2, s3, s4, s5, s6, s7, s8] {
+                prefetch(s.as_ptr().wrapping_add(x0 + PREFETCH_AHEAD));
+            }
+        }
+        for x in x0..x1 {
+            let mut g = [s0[x], s1[x], s2[x], s3[x], s4[x], s5[x], s6[x], s7[x], s8[x]];
+            collide_les::<OP, FORCED, LES>(&mut g, c.relax, c.fx, c.fy);
+            d0[x] = g[0];
+            d1[x] = g[1];
+            d2[x] = g[2];
+            d3[x] = g[3];
+            d4[x] = g[4];
+            d5[x] = g[5];
+            d6[x] = g[6];
+            d7[x] = g[7];
+            d8[x] = g[8];
+        }
+        x0 = x1;
     }
 }
 
@@ -165,7 +182,7 @@ fn dst_rows(row: &mut [f32], nx: usize, lo: usize, hi: usize) -> [&mut [f32]; Q]
 #[inline(always)]
 fn bulk_row_plain<const OP: u8, const FORCED: bool, const LES: bool>(c: &KernelCtx, s: [&[f32]; Q], row: &mut [f32]) {
     let nx = c.nx;
-    collide_run::<OP, FORCED, LES>(c, s, dst_rows(row, nx, 1, nx - 1));
+    collide_run::<OP, FORCED, LES, false>(c, s, dst_rows(row, nx, 1, nx - 1));
 }
 
 /// Interior of a row through an L1-resident buffer written out with non-temporal stores: the
@@ -201,7 +218,7 @@ fn bulk_row_streamed<const OP: u8, const FORCED: bool, const LES: bool>(c: &Kern
             &mut b7[m.clone()],
             &mut b8[m],
         ];
-        collide_run::<OP, FORCED, LES>(c, t, b);
+        collide_run::<OP, FORCED, LES, true>(c, t, b);
         let len = c1 - c0;
         for (i, b) in buf.iter_mut().enumerate() {
             if c0 == 0 {
@@ -284,6 +301,10 @@ fn stream_lines_avx512(dst: &mut [f32], src: &[f32]) {
         unsafe { _mm512_stream_ps(d.as_mut_ptr(), _mm512_loadu_ps(s.as_ptr())) };
     }
 }
+
+/// How far ahead (floats) of the block being loaded the streaming kernels prefetch each source
+/// row (four cache lines; 128 and 256 measured no better in 2D, 256 worse in 3D).
+pub(crate) const PREFETCH_AHEAD: usize = 64;
 
 /// Asks for the cache line holding `p` (`prefetcht0`). A hint: it never faults and changes no
 /// result, so `p` may point anywhere.

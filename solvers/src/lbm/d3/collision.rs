@@ -22,7 +22,7 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 use wide::f32x8;
 
 use super::super::collision::{Relax, OMEGA_BULK, OP_BGK};
-use super::super::kernel::prefetch;
+use super::super::kernel::{prefetch, PREFETCH_AHEAD};
 use super::lattice::Lattice3;
 
 /// Density deviation and momentum: `drho = sum g_i`, `j = sum c_i g_i`.
@@ -301,9 +301,6 @@ pub struct Ends<'a, const Q: usize> {
     pub first: Option<&'a [f32; Q]>,
     pub last: Option<&'a [f32; Q]>,
 }
-
-/// How far ahead (floats) of the block being loaded each source row is prefetched.
-const PREFETCH_AHEAD: usize = 64;
 
 /// Nodes per chunk of [`collide_chunk`].
 pub const CHUNK: usize = 128;
