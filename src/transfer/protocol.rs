@@ -68,7 +68,8 @@ pub struct Protocol {
     /// TD3 actor is trained against a fresh critic and loses what it knew in its first updates.
     #[serde(default)]
     pub init_critics: bool,
-    /// Training configuration of the source runs and of both training arms.
+    /// Training configuration of both training arms, and the source runs' own but for the step
+    /// budget (`train.steps`, the arms').
     #[serde(default)]
     pub config: TrainConfig,
     /// A zero-shot deployment protocol: no training on the target, only the source policies
@@ -265,5 +266,30 @@ mod tests {
         assert_eq!(Protocol::find("channel", "NACA0012").unwrap().name, "channel_wing");
         let e = Protocol::find("channel", "cylinder").unwrap_err().to_string();
         assert!(e.contains("Cylinder_2D_Re200 SquareCylinder_2D_Re200"), "{e}");
+    }
+
+    /// A protocol's configuration is the one its committed source runs were trained with, but
+    /// for the step budget, which a protocol may set for its target's arms (what `hgym
+    /// transfer` would remake them with, and what its train.toml records).
+    #[test]
+    fn bundled_protocols_configure_what_their_source_runs_used() {
+        for p in Protocol::bundled() {
+            for &seed in &p.seeds {
+                let dir = p.source_dir(seed);
+                if !dir.join("manifest.json").exists() {
+                    continue;
+                }
+                let run = super::super::SourceRun::load(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display()));
+                let mut used = TrainConfig::parse(&run.config_toml, "manifest").unwrap();
+                used.train.steps = p.config.train.steps;
+                assert_eq!(
+                    used.to_toml(),
+                    p.config.to_toml(),
+                    "{}: the configuration differs from the one {} was trained with",
+                    p.name,
+                    dir.display()
+                );
+            }
+        }
     }
 }
