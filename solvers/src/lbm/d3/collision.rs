@@ -291,9 +291,6 @@ impl Block for f32x8 {
     }
 }
 
-/// The widest [`Block::LANES`]: room for a block in a plain array.
-const MAX_LANES: usize = 16;
-
 /// The pulls across a periodic x axis, which a row's source slices do not hold: `first[i]` for
 /// the directions with `c_x = 1` at the row's first node, `last[i]` for `c_x = -1` at its last.
 #[derive(Clone, Copy, Default)]
@@ -305,28 +302,35 @@ pub struct Ends<'a, const Q: usize> {
 /// Nodes per chunk of [`collide_chunk`].
 pub const CHUNK: usize = 128;
 
-/// [`collide`] for `m <= CHUNK` consecutive nodes of a row of `n`, from node `x0` on: node `k`
-/// reads direction `i` from `src[i][k]` (or from `ends` at the row's two ends) and writes it to
-/// `out[i][k]`, in blocks of `B::LANES` nodes ([`collide_lanes`] on `B`), what is left in blocks
-/// of 8 (so a 16-lane `B` wastes no more lanes on a short row than `f32x8` does), and a last,
-/// partial block padded with zeros (the rest state) that are computed and dropped. The chunk
-/// goes through a buffer in L1 rather than straight to the rows: full cache lines, one direction
-/// after the other, are what the non-temporal stores need (32-byte stores to 19 or 27 rows at
-/// once measured 10-15 % slower, with ordinary stores too).
+/// The nodes [`collide_chunk`] collides: `m <= CHUNK` consecutive nodes of a row of `n`, from
+/// node `x0` on; node `k` reads direction `i` from `src[i][k]` (or from `ends` at the row's two
+/// ends).
+#[derive(Clone, Copy)]
+pub struct Chunk<'a, const Q: usize> {
+    pub src: &'a [&'a [f32]; Q],
+    pub x0: usize,
+    pub m: usize,
+    pub n: usize,
+    pub ends: Ends<'a, Q>,
+    pub relax: Relax,
+    pub f: [f32; 3],
+}
+
+/// [`collide`] for the nodes of a [`Chunk`], node `k` written to `out[i][k]`: in blocks of
+/// `B::LANES` nodes ([`collide_lanes`] on `B`), what is left in blocks of 8 (so a 16-lane `B`
+/// wastes no more lanes on a short row than `f32x8` does), and a last, partial block padded with
+/// zeros (the rest state) that are computed and dropped. The chunk goes through a buffer in L1
+/// rather than straight to the rows: full cache lines, one direction after the other, are what
+/// the non-temporal stores need (32-byte stores to 19 or 27 rows at once measured 10-15 % slower,
+/// with ordinary stores too).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 pub fn collide_chunk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
-    src: &[&[f32]; Q],
-    x0: usize,
-    m: usize,
-    n: usize,
-    ends: Ends<Q>,
+    ch: &Chunk<Q>,
     out: &mut [[f32; CHUNK]; Q],
-    relax: Relax,
-    f: [f32; 3],
 ) {
-    let x = full_blocks::<B, Q, L, OP, FORCED, LES>(src, 0, x0, m, n, ends, out, relax, f);
-    let x = full_blocks::<f32x8, Q, L, OP, FORCED, LES>(src, x, x0, m, n, ends, out, relax, f);
+    let x = full_blocks::<B, Q, L, OP, FORCED, LES>(ch, 0, out);
+    let x = full_blocks::<f32x8, Q, L, OP, FORCED, LES>(ch, x, out);
+    let (src, m) = (ch.src, ch.m);
     if x < m {
         let len = m - x;
         let mut g = [f32x8::ZERO; Q];
@@ -335,8 +339,8 @@ pub fn collide_chunk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, con
             v[..len].copy_from_slice(&src[i][x..m]);
             g[i] = f32x8::new(v);
         }
-        patch_ends::<f32x8, Q, L>(&mut g, x0 + x, len, n, ends);
-        collide_lanes::<f32x8, Q, L, OP, FORCED, LES>(&mut g, relax, f);
+        patch_ends::<f32x8, Q, L>(&mut g, ch.x0 + x, len, ch.n, ch.ends);
+        collide_lanes::<f32x8, Q, L, OP, FORCED, LES>(&mut g, ch.relax, ch.f);
         for i in 0..Q {
             out[i][x..m].copy_from_slice(&g[i].to_array()[..len]);
         }
@@ -346,29 +350,23 @@ pub fn collide_chunk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, con
 /// The whole blocks of `B::LANES` nodes of [`collide_chunk`] from chunk node `x` on; returns
 /// where they end.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn full_blocks<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
-    src: &[&[f32]; Q],
+    ch: &Chunk<Q>,
     mut x: usize,
-    x0: usize,
-    m: usize,
-    n: usize,
-    ends: Ends<Q>,
     out: &mut [[f32; CHUNK]; Q],
-    relax: Relax,
-    f: [f32; 3],
 ) -> usize {
+    let (src, x0, n) = (ch.src, ch.x0, ch.n);
     let lanes = B::LANES;
-    while x + lanes <= m {
+    while x + lanes <= ch.m {
         let mut g = [B::splat(0.0); Q];
         for i in 0..Q {
             g[i] = B::load(&src[i][x..]);
             prefetch(src[i].as_ptr().wrapping_add(x + PREFETCH_AHEAD));
         }
         if x0 + x == 0 || x0 + x + lanes == n {
-            patch_ends::<B, Q, L>(&mut g, x0 + x, lanes, n, ends);
+            patch_ends::<B, Q, L>(&mut g, x0 + x, lanes, n, ch.ends);
         }
-        collide_lanes::<B, Q, L, OP, FORCED, LES>(&mut g, relax, f);
+        collide_lanes::<B, Q, L, OP, FORCED, LES>(&mut g, ch.relax, ch.f);
         for i in 0..Q {
             g[i].store(&mut out[i][x..]);
         }
@@ -390,7 +388,8 @@ fn patch_ends<B: Block, const Q: usize, L: Lattice3<Q>>(g: &mut [B; Q], x: usize
             _ => None,
         };
         if let Some((l, v)) = lane {
-            let mut a = [0.0f32; MAX_LANES];
+            // Room for the widest block (16 lanes).
+            let mut a = [0.0f32; 16];
             g[i].store(&mut a);
             a[l] = v;
             g[i] = B::load(&a);

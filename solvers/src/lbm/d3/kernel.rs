@@ -15,8 +15,8 @@ use wide::f32x8;
 
 use super::super::collision::Relax;
 pub(crate) use super::super::kernel::Special;
-use super::super::kernel::{nt_rows_possible, store_fence, stream_lines};
-use super::collision::{collide, collide_chunk, moments, Block, Ends, CHUNK};
+use super::super::kernel::{nt_rows_possible, prefetch, store_fence, stream_lines};
+use super::collision::{collide, collide_chunk, moments, Block, Chunk, Ends, CHUNK};
 use super::lattice::Lattice3;
 use super::sides::{face_source, face_value, face_value_planned, plan_face_pull, Faces};
 use super::sponge::Layers;
@@ -340,6 +340,8 @@ fn bulk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bo
             let c_x = L::C_REF[i][0];
             if c_x == 1 {
                 first[i] = src[row + nx - 1];
+                // The next row's (usually `nx` on): a line no stream of this row reaches.
+                prefetch(src.as_ptr().wrapping_add(row + 2 * nx - 1));
             }
             if c_x == -1 {
                 last[i] = src[row];
@@ -362,7 +364,16 @@ fn bulk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bo
         for i in 0..Q {
             t[i] = &s[i][c0..c1];
         }
-        collide_chunk::<B, Q, L, OP, FORCED, LES>(&t, c0, c1 - c0, nx, ends, buf, c.relax, c.force);
+        let chunk = Chunk {
+            src: &t,
+            x0: c0,
+            m: c1 - c0,
+            n: nx,
+            ends,
+            relax: c.relax,
+            f: c.force,
+        };
+        collide_chunk::<B, Q, L, OP, FORCED, LES>(&chunk, buf);
         c.layers.chunk(buf, c0, c1 - c0, y, z);
         for (i, b) in buf.iter().enumerate() {
             let row = (i * ny + y) * nx;
