@@ -36,6 +36,13 @@ pub const BUNDLED: &[(&str, &str)] = &[
     ),
 ];
 
+/// The training configurations bundled protocols name in `config_file`, by that path: a
+/// protocol reads them from here, so that `hgym transfer` runs from any folder.
+const BUNDLED_CONFIGS: &[(&str, &str)] = &[(
+    "benchmarks/train/TCFOpen_3D_Retau206-td3.toml",
+    include_str!("../../benchmarks/train/TCFOpen_3D_Retau206-td3.toml"),
+)];
+
 /// The three arms, in the order they run.
 pub const ARMS: [&str; 3] = ["zeroshot", "finetune", "scratch"];
 
@@ -69,9 +76,14 @@ pub struct Protocol {
     #[serde(default)]
     pub init_critics: bool,
     /// Training configuration of both training arms, and the source runs' own but for the step
-    /// budget (`train.steps`, the arms').
+    /// budget (`train.steps`, the arms'): a `[config]` table, or read from `config_file`.
     #[serde(default)]
     pub config: TrainConfig,
+    /// The training configuration file `config` is read from (a path from the repository root,
+    /// e.g. the source runs' `benchmarks/train/TCFOpen_3D_Retau206-td3.toml`), so that a
+    /// protocol keeps no copy of it that could drift.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub config_file: Option<String>,
     /// A zero-shot deployment protocol: no training on the target, only the source policies
     /// deployed beside the uncontrolled flow and classical controllers ([`super::deploy`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -119,8 +131,22 @@ pub enum ProtocolError {
     },
     #[error("{origin}: {message}")]
     Invalid { origin: String, message: String },
+    #[error("{origin}: its config_file")]
+    Config {
+        origin: String,
+        #[source]
+        source: Box<crate::train::config::ConfigError>,
+    },
     #[error("no transfer protocol from '{source_name}' to '{target}'; the protocols are:\n{list}")]
     UnknownPair { source_name: String, target: String, list: String },
+}
+
+/// The training configuration at `path`: a bundled one, else the file.
+fn read_config(path: &str) -> Result<TrainConfig, crate::train::config::ConfigError> {
+    match BUNDLED_CONFIGS.iter().find(|(p, _)| *p == path) {
+        Some((_, text)) => TrainConfig::parse(text, path),
+        None => TrainConfig::load(Path::new(path)),
+    }
 }
 
 impl Protocol {
@@ -131,6 +157,18 @@ impl Protocol {
             message,
         };
         let mut p: Protocol = toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
+        if let Some(file) = &p.config_file {
+            let table: toml::Table = toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
+            if table.contains_key("config") {
+                return Err(invalid(format!(
+                    "both config_file = \"{file}\" and a [config] table; keep one (the file, when the source runs were trained with it)"
+                )));
+            }
+            p.config = read_config(file).map_err(|source| ProtocolError::Config {
+                origin: origin.to_string(),
+                source: Box::new(source),
+            })?;
+        }
         hgym_agents::learn::algorithm(&p.algo).map_err(|e| invalid(e.to_string()))?;
         p.config.algos = p.config.algos.complete().map_err(|e| invalid(e.to_string()))?;
         if p.seeds.is_empty() {
@@ -266,6 +304,24 @@ mod tests {
         assert_eq!(Protocol::find("channel", "NACA0012").unwrap().name, "channel_wing");
         let e = Protocol::find("channel", "cylinder").unwrap_err().to_string();
         assert!(e.contains("Cylinder_2D_Re200 SquareCylinder_2D_Re200"), "{e}");
+    }
+
+    /// `config_file` gives the configuration of that file; given beside a `[config]` table, or
+    /// naming no file, the protocol is refused with what to do.
+    #[test]
+    fn config_file_is_read_and_not_doubled() {
+        let wing = Protocol::find("channel", "naca0012").unwrap();
+        let file = wing.config_file.clone().unwrap();
+        let text = std::fs::read_to_string(&file).unwrap();
+        assert_eq!(wing.config, TrainConfig::parse(&text, &file).unwrap());
+        let (_, bundled) = BUNDLED.iter().find(|(n, _)| *n == "channel_wing").unwrap();
+        let doubled = format!("{bundled}\n[config.train]\nsteps = 10\n");
+        let e = Protocol::parse(&doubled, "doubled").unwrap_err().to_string();
+        assert!(e.contains("both config_file") && e.contains("keep one"), "{e}");
+        let missing = bundled.replace(&file, "no/such/config.toml");
+        let e = Protocol::parse(&missing, "missing").unwrap_err();
+        let chain = format!("{e}: {}", std::error::Error::source(&e).unwrap());
+        assert!(chain.contains("config_file") && chain.contains("no/such/config.toml"), "{chain}");
     }
 
     /// A protocol's configuration is the one its committed source runs were trained with, but
