@@ -124,6 +124,22 @@ macro_rules! each_pair {
     };
 }
 
+/// Runs `$body` once for each direction `$i` below `$q`, unrolled (as [`each_pair`]): with every
+/// index a constant, the block's populations stay in registers instead of a stack array.
+macro_rules! each_dir {
+    ($q:expr, |$i:ident| $body:block) => {
+        each_dir!(@ $q, $i, $body, 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26)
+    };
+    (@ $q:expr, $i:ident, $body:block, $($k:literal)*) => {
+        $(
+            if $k < $q {
+                let $i: usize = $k;
+                $body
+            }
+        )*
+    };
+}
+
 /// One collision of `g` in place, on one node or a block of nodes. `OP` selects BGK or the
 /// regularised operator (any other code), `FORCED` adds Guo forcing with `f`, `LES` the
 /// Smagorinsky viscosity (regularised only).
@@ -359,17 +375,17 @@ fn full_blocks<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FOR
     let lanes = B::LANES;
     while x + lanes <= ch.m {
         let mut g = [B::splat(0.0); Q];
-        for i in 0..Q {
+        each_dir!(Q, |i| {
             g[i] = B::load(&src[i][x..]);
             prefetch(src[i].as_ptr().wrapping_add(x + PREFETCH_AHEAD));
-        }
+        });
         if x0 + x == 0 || x0 + x + lanes == n {
             patch_ends::<B, Q, L>(&mut g, x0 + x, lanes, n, ch.ends);
         }
         collide_lanes::<B, Q, L, OP, FORCED, LES>(&mut g, ch.relax, ch.f);
-        for i in 0..Q {
+        each_dir!(Q, |i| {
             g[i].store(&mut out[i][x..]);
-        }
+        });
         x += lanes;
     }
     x
@@ -380,7 +396,7 @@ fn full_blocks<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FOR
 /// that pull across the other end (`c_x = -1`).
 #[inline(always)]
 fn patch_ends<B: Block, const Q: usize, L: Lattice3<Q>>(g: &mut [B; Q], x: usize, len: usize, m: usize, ends: Ends<Q>) {
-    for i in 0..Q {
+    each_dir!(Q, |i| {
         let c_x = L::C_REF[i][0];
         let lane = match (c_x, ends.first, ends.last) {
             (1, Some(first), _) if x == 0 => Some((0, first[i])),
@@ -394,7 +410,7 @@ fn patch_ends<B: Block, const Q: usize, L: Lattice3<Q>>(g: &mut [B; Q], x: usize
             a[l] = v;
             g[i] = B::load(&a);
         }
-    }
+    });
 }
 
 #[cfg(test)]
