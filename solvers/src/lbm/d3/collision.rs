@@ -124,7 +124,7 @@ macro_rules! each_pair {
     };
 }
 
-/// Runs `$body` once for each direction `$i` below `$q`, unrolled (as [`each_pair`]): with every
+/// Runs `$body` once for each direction `$i` below `$q`, unrolled (as `each_pair!`): with every
 /// index a constant, the block's populations stay in registers instead of a stack array.
 macro_rules! each_dir {
     ($q:expr, |$i:ident| $body:block) => {
