@@ -107,32 +107,18 @@ fn dot<V: Lanes>(c: [i32; 3], v: [V; 3]) -> V {
     acc
 }
 
-/// Runs `$body` once for each pair index `$p` below `$n`, unrolled: each `$p` is a literal, so
-/// the velocity of the pair is a constant in its copy of the body and the sign tests fold away
-/// (a loop over 9 or 13 pairs is not unrolled by the compiler).
-macro_rules! each_pair {
-    ($n:expr, |$p:ident| $body:block) => {
-        each_pair!(@ $n, $p, $body, 0 1 2 3 4 5 6 7 8 9 10 11 12)
+/// Runs `$body` once for each index `$i` below `$n` (at most 27: a direction of D3Q27 or one of
+/// its 13 opposite pairs), unrolled. Each `$i` is a literal, so a pair's velocity is a constant in
+/// its copy of the body and the sign tests fold away, and a block's populations indexed by it stay
+/// in registers instead of a stack array (a loop over 9, 13 or 27 is not unrolled by the
+/// compiler, and a dynamic index keeps an array in memory).
+macro_rules! unrolled {
+    ($n:expr, |$i:ident| $body:block) => {
+        unrolled!(@ $n, $i, $body, 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26)
     };
-    (@ $n:expr, $p:ident, $body:block, $($k:literal)*) => {
+    (@ $n:expr, $i:ident, $body:block, $($k:literal)*) => {
         $(
             if $k < $n {
-                let $p: usize = $k;
-                $body
-            }
-        )*
-    };
-}
-
-/// Runs `$body` once for each direction `$i` below `$q`, unrolled (as `each_pair!`): with every
-/// index a constant, the block's populations stay in registers instead of a stack array.
-macro_rules! each_dir {
-    ($q:expr, |$i:ident| $body:block) => {
-        each_dir!(@ $q, $i, $body, 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26)
-    };
-    (@ $q:expr, $i:ident, $body:block, $($k:literal)*) => {
-        $(
-            if $k < $q {
                 let $i: usize = $k;
                 $body
             }
@@ -166,7 +152,7 @@ pub fn collide_lanes<V: Lanes, const Q: usize, L: Lattice3<Q>, const OP: u8, con
     let mut drho = g[0];
     let mut j = [splat(-0.0); 3];
     let mut pi = [splat(-0.0); 6];
-    each_pair!(pairs, |p| {
+    unrolled!(pairs, |p| {
         let c = c_of(p);
         let s = g[2 * p + 1] + g[2 * p + 2];
         let d = g[2 * p + 1] - g[2 * p + 2];
@@ -200,7 +186,7 @@ pub fn collide_lanes<V: Lanes, const Q: usize, L: Lattice3<Q>, const OP: u8, con
     let mut omega = splat(relax.omega);
     if OP == OP_BGK {
         g[0] = g[0] - omega * (g[0] - splat(L::W_REF[0]) * base);
-        each_pair!(pairs, |p| {
+        unrolled!(pairs, |p| {
             let (c, w) = (c_of(p), splat(w_of(p)));
             let cu = dot(c, u);
             let even = w * (base + h * (cu * cu));
@@ -239,7 +225,7 @@ pub fn collide_lanes<V: Lanes, const Q: usize, L: Lattice3<Q>, const OP: u8, con
         }
         let q_tr = (q[0] + q[1] + q[2]) * splat(1.0 / 3.0);
         g[0] = splat(L::W_REF[0]) * (base - q_tr);
-        each_pair!(pairs, |p| {
+        unrolled!(pairs, |p| {
             let (c, w) = (c_of(p), splat(w_of(p)));
             let cu = dot(c, u);
             let mut qpi = -q_tr;
@@ -265,7 +251,7 @@ pub fn collide_lanes<V: Lanes, const Q: usize, L: Lattice3<Q>, const OP: u8, con
         let sf = splat(1.0) - splat(0.5) * omega;
         let uf3 = splat(3.0) * (u[0] * fv[0] + u[1] * fv[1] + u[2] * fv[2]);
         g[0] = g[0] - sf * splat(L::W_REF[0]) * uf3;
-        each_pair!(pairs, |p| {
+        unrolled!(pairs, |p| {
             let (c, w) = (c_of(p), splat(w_of(p)));
             let cf = dot(c, fv);
             let even = sf * w * (splat(9.0) * dot(c, u) * cf - uf3);
@@ -375,7 +361,7 @@ fn full_blocks<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FOR
     let lanes = B::LANES;
     while x + lanes <= ch.m {
         let mut g = [B::splat(0.0); Q];
-        each_dir!(Q, |i| {
+        unrolled!(Q, |i| {
             g[i] = B::load(&src[i][x..]);
             prefetch(src[i].as_ptr().wrapping_add(x + PREFETCH_AHEAD));
         });
@@ -383,7 +369,7 @@ fn full_blocks<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FOR
             patch_ends::<B, Q, L>(&mut g, x0 + x, lanes, n, ch.ends);
         }
         collide_lanes::<B, Q, L, OP, FORCED, LES>(&mut g, ch.relax, ch.f);
-        each_dir!(Q, |i| {
+        unrolled!(Q, |i| {
             g[i].store(&mut out[i][x..]);
         });
         x += lanes;
@@ -396,7 +382,7 @@ fn full_blocks<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FOR
 /// that pull across the other end (`c_x = -1`).
 #[inline(always)]
 fn patch_ends<B: Block, const Q: usize, L: Lattice3<Q>>(g: &mut [B; Q], x: usize, len: usize, m: usize, ends: Ends<Q>) {
-    each_dir!(Q, |i| {
+    unrolled!(Q, |i| {
         let c_x = L::C_REF[i][0];
         let lane = match (c_x, ends.first, ends.last) {
             (1, Some(first), _) if x == 0 => Some((0, first[i])),
