@@ -158,6 +158,8 @@ impl Protocol {
         };
         let mut p: Protocol = toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
         if let Some(file) = &p.config_file {
+            // A second parse, as a table, only to see whether `[config]` was written: parsing
+            // once to a table and converting it would cost every error its line and column.
             let table: toml::Table = toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
             if table.contains_key("config") {
                 return Err(invalid(format!(
@@ -296,6 +298,13 @@ mod tests {
             );
             let spec = crate::train::resolve_spec(&p.source, &p.config).unwrap();
             assert_eq!(spec.hash(), p.source_spec_hash, "{}: pinned source hash", p.name);
+            if let Some(file) = &p.config_file {
+                assert!(
+                    BUNDLED_CONFIGS.iter().any(|(path, _)| path == file),
+                    "{}: config_file {file} is not in BUNDLED_CONFIGS, so `hgym transfer` would read it from the working folder",
+                    p.name
+                );
+            }
         }
         assert_eq!(
             Protocol::find("cylinder_2d_re200", "Cylinder_2D_Re1000").unwrap().name,
