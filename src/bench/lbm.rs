@@ -99,6 +99,12 @@ pub struct BenchRow {
     pub copy_method: CopyMethod,
     pub roofline_mlups: f64,
     pub roofline_fraction: f64,
+    /// 3D: MLUPS of the same kernel with its collision taken out (free streaming), timed right
+    /// after it: what the kernel's memory access pattern (Q shifted source rows read, Q
+    /// destination rows written, per row) allows. `mlups` over it is the share of that ceiling
+    /// the collision leaves; it over `roofline_mlups`, how far the pattern is from a plain copy.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub streaming_mlups: Option<f64>,
     /// The correctness check at this size: largest velocity error of the Taylor-Green vortex
     /// against its exact decay, as a fraction of its amplitude.
     pub check_error: f64,
@@ -172,6 +178,10 @@ trait Vortex {
     fn time(&self) -> u64;
     /// x velocity at node (x, y) (z = 0).
     fn u(&self, x: usize, y: usize) -> f64;
+    /// `steps` steps of the kernel without its collision (the 3D kernels only).
+    fn advance_streaming_only(&mut self, _steps: u64) -> Result<(), BenchError> {
+        Err(BenchError::Input("free streaming is timed for the 3D kernels only".into()))
+    }
 }
 
 impl Vortex for D2q9 {
@@ -199,6 +209,12 @@ impl<const Q: usize, L: Lattice3<Q>> Vortex for Lbm3<Q, L> {
     fn u(&self, x: usize, y: usize) -> f64 {
         self.rho_u([x, y, 0]).1[0]
     }
+    fn advance_streaming_only(&mut self, steps: u64) -> Result<(), BenchError> {
+        for _ in 0..steps {
+            self.step_streaming_only()?;
+        }
+        Ok(())
+    }
 }
 
 /// The Taylor-Green vortex's density `1 + 3 p` with its pressure
@@ -225,6 +241,17 @@ fn vortex_3d<const Q: usize, L: Lattice3<Q>>(n: [usize; 3], collision: Collision
         )
     });
     Ok(Box::new(s))
+}
+
+/// The shortest of three timings of `run`, in seconds.
+fn best_of_3(mut run: impl FnMut() -> Result<(), BenchError>) -> Result<f64, BenchError> {
+    let mut dt = f64::INFINITY;
+    for _ in 0..3 {
+        let t = Instant::now();
+        run()?;
+        dt = dt.min(t.elapsed().as_secs_f64());
+    }
+    Ok(dt)
 }
 
 /// The Taylor-Green vortex on a periodic grid of `n` nodes.
@@ -274,12 +301,7 @@ pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Resu
                 s.advance(3)?;
                 let per_step = t.elapsed().as_secs_f64() / 3.0;
                 let steps = ((opts.seconds / 3.0 / per_step.max(1e-9)) as u64).max(3);
-                let mut dt = f64::INFINITY;
-                for _ in 0..3 {
-                    let t = Instant::now();
-                    s.advance(steps)?;
-                    dt = dt.min(t.elapsed().as_secs_f64());
-                }
+                let dt = best_of_3(|| s.advance(steps))?;
                 // Check: velocity against the exact decay u0 exp(-nu k^2 t).
                 let rate = (TAU - 0.5) / 3.0 * (kw[0] * kw[0] + kw[1] * kw[1]);
                 let amp = U0 * (-rate * s.time() as f64).exp();
@@ -292,6 +314,11 @@ pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Resu
                 }
                 let cells = (nx * ny * nz) as f64;
                 let mlups = cells * steps as f64 / dt / 1e6;
+                // After the check: free streaming leaves the vortex behind.
+                let streaming_mlups = match opts.lattice {
+                    BenchLattice::D2q9 => None,
+                    _ => Some(cells * steps as f64 / best_of_3(|| s.advance_streaming_only(steps))? / 1e6),
+                };
                 let roofline = copy_gbs * 1e9 / bytes as f64 / 1e6;
                 Ok(BenchRow {
                     nx,
@@ -306,6 +333,7 @@ pub fn bench_lbm(opts: &LbmBenchOptions, progress: &mut dyn FnMut(&str)) -> Resu
                     copy_method: copy.method,
                     roofline_mlups: roofline,
                     roofline_fraction: mlups / roofline,
+                    streaming_mlups,
                     check_error: err,
                     memory_bound: k + 1 == n_sizes,
                 })
@@ -365,13 +393,33 @@ impl BenchReport {
             self.bytes_per_cell,
             self.bytes_per_cell
         );
+        let streaming = self.rows.iter().any(|r| r.streaming_mlups.is_some());
         s += &format!(
-            "  {:>11} {:>9} {:>7} {:>9} {:>10} {:>10} {:>7} {:>10} {:>9}  {}\n",
-            "grid", "MB", "threads", "MLUPS", "kern GB/s", "copy GB/s", "copy", "roof MLUPS", "fraction", "check"
+            "  {:>11} {:>9} {:>7} {:>9} {:>10} {:>10} {:>7} {:>10} {:>9}{}  {}\n",
+            "grid",
+            "MB",
+            "threads",
+            "MLUPS",
+            "kern GB/s",
+            "copy GB/s",
+            "copy",
+            "roof MLUPS",
+            "fraction",
+            if streaming {
+                format!(" {:>11} {:>9}", "free MLUPS", "of free")
+            } else {
+                String::new()
+            },
+            "check"
         );
         for r in &self.rows {
+            let free = match r.streaming_mlups {
+                Some(m) => format!(" {:>11.1} {:>8.0}%", m, 100.0 * r.mlups / m),
+                None if streaming => format!(" {:>11} {:>9}", "-", "-"),
+                None => String::new(),
+            };
             s += &format!(
-                "  {:>11} {:>9.1} {:>7} {:>9.1} {:>10.2} {:>10.2} {:>7} {:>10.1} {:>8.0}%  TG err {:.1e}{}\n",
+                "  {:>11} {:>9.1} {:>7} {:>9.1} {:>10.2} {:>10.2} {:>7} {:>10.1} {:>8.0}%{free}  TG err {:.1e}{}\n",
                 grid_name(r),
                 r.megabytes,
                 r.threads,
@@ -389,6 +437,9 @@ impl BenchReport {
             Some(t) => format!(" and {:.0}% with one", 100.0 * t),
             None => String::new(),
         };
+        if streaming {
+            s += "  free MLUPS: the same kernel with no collision (free streaming), timed right after it: the ceiling of its memory access pattern (Q shifted rows read, Q rows written)\n";
+        }
         s += &format!(
             "  target: >= {:.0}% of the roofline at the memory-bound size with all threads{one}: {}\n",
             100.0 * self.target_fraction,

@@ -62,6 +62,9 @@ pub const OP_BGK: u8 = 0;
 pub const OP_REG: u8 = 1;
 /// See [`OP_BGK`].
 pub const OP_RR: u8 = 2;
+/// No collision (free streaming), for `hgym bench lbm` only: the 3D kernel's memory traffic with
+/// none of its arithmetic, the ceiling its access pattern allows (see `Lbm3::step_streaming_only`).
+pub const OP_STREAM: u8 = u8::MAX;
 
 impl Collision {
     /// Smallest `tau - 1/2` the operator is allowed to run with. Below it the scheme has no

@@ -21,7 +21,7 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use wide::f32x8;
 
-use super::super::collision::{Relax, OMEGA_BULK, OP_BGK};
+use super::super::collision::{Relax, OMEGA_BULK, OP_BGK, OP_STREAM};
 use super::super::kernel::{prefetch, PREFETCH_AHEAD};
 use super::lattice::Lattice3;
 
@@ -126,9 +126,9 @@ macro_rules! unrolled {
     };
 }
 
-/// One collision of `g` in place, on one node or a block of nodes. `OP` selects BGK or the
-/// regularised operator (any other code), `FORCED` adds Guo forcing with `f`, `LES` the
-/// Smagorinsky viscosity (regularised only).
+/// One collision of `g` in place, on one node or a block of nodes. `OP` selects BGK, none
+/// ([`OP_STREAM`], for the benchmark) or the regularised operator (any other code), `FORCED` adds
+/// Guo forcing with `f`, `LES` the Smagorinsky viscosity (regularised only).
 ///
 /// Written on the opposite pairs `(i, i + 1)` of the velocity set ([`Lattice3::PAIRED`]):
 /// with `s = g_i + g_o` and `d = g_i - g_o`, the moments are `drho = g_0 + sum s`,
@@ -143,6 +143,9 @@ pub fn collide_lanes<V: Lanes, const Q: usize, L: Lattice3<Q>, const OP: u8, con
     relax: Relax,
     f: [f32; 3],
 ) {
+    if OP == OP_STREAM {
+        return;
+    }
     let () = L::PAIRED;
     let splat = V::splat;
     let pairs = (Q - 1) / 2;

@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 
 use super::super::aligned::AlignedVec;
-use super::super::collision::{Collision, Relax, OP_BGK, OP_REG};
+use super::super::collision::{Collision, Relax, OP_BGK, OP_REG, OP_STREAM};
 use super::super::error::LbmError;
 use super::super::solver::STREAM_STORES_ABOVE_BYTES;
 use super::collision::{collide, equilibrium, moments};
@@ -834,6 +834,23 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             self.cfg.smagorinsky > 0.0,
             self.narrow_blocks,
         );
+        self.step_with(kernel)
+    }
+
+    /// A step of the same kernel with no collision (free streaming: every population pulled and
+    /// stored, no arithmetic), for `hgym bench lbm`: the ceiling the kernel's memory access
+    /// pattern allows, measured beside the kernel. Not a flow: the populations only travel.
+    #[doc(hidden)]
+    pub fn step_streaming_only(&mut self) -> Result<(), LbmError> {
+        let kernel: PlaneFn = if self.narrow_blocks {
+            plane_narrow::<Q, L, OP_STREAM, false, false>
+        } else {
+            plane_widest::<Q, L, OP_STREAM, false, false>
+        };
+        self.step_with(kernel)
+    }
+
+    fn step_with(&mut self, kernel: PlaneFn) -> Result<(), LbmError> {
         self.face_moments.fill::<Q, L>(self.cfg.n, &self.f);
         let ctx = ctx::<Q>(
             &self.cfg,
