@@ -397,7 +397,9 @@ type Case<const Q: usize, L> = fn(Collision, f64) -> Lbm3<Q, L>;
 
 /// Rows a multiple of 8 long written with non-temporal stores, across several chunks of the
 /// bulk loop, with absorbing layers across the rows (one ending inside the second chunk) and
-/// along them (which the fast kernel applies chunk by chunk and node by node).
+/// along them (which the fast kernel applies chunk by chunk and node by node), and two spheres
+/// whose solid and wall-link nodes (specials inside streamed rows) fall in the first and second
+/// chunk and in the last, partial one.
 fn oracle_case_streamed<const Q: usize, L: Lattice3<Q>>(collision: Collision, smagorinsky: f64) -> Lbm3<Q, L> {
     let mut cfg = D3Config::new([264, 6, 5], 0.52);
     cfg.collision = collision;
@@ -413,7 +415,15 @@ fn oracle_case_streamed<const Q: usize, L: Lattice3<Q>>(collision: Collision, sm
         u: [0.03, 0.002, -0.001],
     };
     cfg.sponges = vec![layer(0, 140), layer(1, 20), layer(2, 2)];
-    let mut s = Lbm3::<Q, L>::new(cfg, &[]).unwrap();
+    let across_chunks = Sphere {
+        center: [127.6, 2.7, 2.2],
+        radius: 1.9,
+    };
+    let in_last_chunk = Sphere {
+        center: [259.5, 3.0, 2.5],
+        radius: 1.5,
+    };
+    let mut s = Lbm3::<Q, L>::new(cfg, &[&across_chunks, &in_last_chunk]).unwrap();
     s.set_equilibrium(|x, y, z| {
         (
             1.0 + 0.001 * ((x + 2 * y) % 5) as f64,

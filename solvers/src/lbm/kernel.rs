@@ -319,12 +319,12 @@ pub(crate) fn prefetch(p: *const f32) {
     };
 }
 
-/// Orders the non-temporal stores before all later stores and loads of this thread (`sfence`),
-/// so the general path's ordinary stores to the edge nodes land after them and other threads
-/// see the row once the step's join completes.
+/// Orders the non-temporal stores before all later stores and loads of this thread (`sfence`,
+/// SSE, so on every x86-64), so that ordinary stores to the same nodes (the 2D general path's
+/// edge nodes) land after them and other threads see them once the step's join completes.
 #[inline(always)]
 pub(crate) fn store_fence() {
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+    #[cfg(target_arch = "x86_64")]
     // SAFETY: `sfence` takes no operands, touches no memory and cannot fault.
     unsafe {
         core::arch::x86_64::_mm_sfence()
