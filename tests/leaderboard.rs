@@ -58,6 +58,13 @@ fn leaderboard_rebuilds_the_committed_one_from_the_committed_results() {
         );
     }
     assert!(pngs >= 1);
+    // A single run has no spread to show: its row gives the mean alone.
+    for row in md
+        .lines()
+        .filter(|l| l.starts_with("| ") && l.split('|').nth(4).map(str::trim) == Some("1"))
+    {
+        assert!(!row.contains('±'), "a one-run entry shows a spread: {row}");
+    }
     // Stale entries: the pinball TD3 runs were trained on spec 2560ad80, which the registry no
     // longer gives Pinball_2D_Re100; the Kolmogorov comparison runs use an [env] override of the
     // objective (spec 777475c1), which it still gives. Stale entries come after every current one.
