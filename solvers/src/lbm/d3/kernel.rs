@@ -196,6 +196,13 @@ impl Ctx<'_> {
         }
     }
 
+    /// The specials of row `r = z ny + y`, and the number of the first of them.
+    #[inline(always)]
+    fn row_specials(&self, r: usize) -> (usize, &[Special]) {
+        let first = self.row_start[r] as usize;
+        (first, &self.specials[first..self.row_start[r + 1] as usize])
+    }
+
     #[inline(always)]
     pub fn is_solid(&self, p: [usize; 3]) -> bool {
         self.solid[(p[2] * self.n[1] + p[1]) * self.n[0] + p[0]]
@@ -316,11 +323,10 @@ pub(crate) fn plan_pulls<const Q: usize, L: Lattice3<Q>>(c: &Ctx, p: [usize; 3],
 /// read-for-ownership of the destination: `2 Q 4` bytes of traffic per node instead of `3 Q 4`).
 /// Along a periodic x the two ends' pulls across the axis are read separately ([`Ends`]);
 /// otherwise the values at `x = 0` and `nx - 1` are wrong (their pulls run into the neighbouring
-/// rows). The row's `specials` (the first is special number `first_special`) replace their
-/// nodes' values in the buffer before it is written, so the row gets no ordinary stores after
-/// its non-temporal ones and needs no fence of its own ([`plane`] fences once).
+/// rows). The row's specials replace their nodes' values in the buffer before it is written, so
+/// the row gets no ordinary stores after its non-temporal ones and needs no fence of its own
+/// ([`plane`] fences once).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn bulk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bool, const LES: bool>(
     c: &Ctx,
     src: &[f32],
@@ -329,10 +335,9 @@ fn bulk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bo
     z: usize,
     out: &mut [f32],
     buf: &mut [[f32; CHUNK]; Q],
-    specials: &[Special],
-    first_special: usize,
 ) {
     let [nx, ny, _] = c.n;
+    let (first_special, specials) = c.row_specials(z * ny + y);
     // Source rows, and along a periodic x the row's two ends' pulls across it (from the same
     // source rows). Plain loops: `array::from_fn` closures are not inlined here.
     let periodic_x = c.periodic[0];
@@ -442,12 +447,11 @@ fn plane<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: b
     let mut buf = [[0.0f32; CHUNK]; Q];
     for y in 0..ny {
         let r = z * ny + y;
-        let first = c.row_start[r] as usize;
-        let specials = &c.specials[first..c.row_start[r + 1] as usize];
         if nx >= 3 && c.row_bulk[r] {
-            bulk::<B, Q, L, OP, FORCED, LES>(c, src, src_ext, y, z, out, &mut buf, specials, first);
+            bulk::<B, Q, L, OP, FORCED, LES>(c, src, src_ext, y, z, out, &mut buf);
             continue;
         }
+        let (first, specials) = c.row_specials(r);
         for (s, sp) in (first..).zip(specials) {
             let g = special::<Q, L, OP, FORCED, LES>(c, src, s, sp, y, z);
             for (i, gi) in g.iter().enumerate() {
