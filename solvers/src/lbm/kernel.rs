@@ -10,16 +10,7 @@ use super::boundary::{bouzidi, side_value, InletReference};
 use super::collision::{collide_les, Collision, Relax, OP_BGK, OP_REG, OP_RR};
 use super::domain::Sides;
 use super::lattice::{CX, CY, Q};
-
-/// A node that needs the general path.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Special {
-    pub x: u32,
-    pub solid: bool,
-    /// Range of this node's links in the link list.
-    pub link_start: u32,
-    pub link_end: u32,
-}
+pub(crate) use super::specials::{RowSpecials, Special};
 
 /// A lattice link from fluid node `cell` whose streaming source in direction `k` (the node
 /// `cell - c_k`) is inside a body; the wall is at fraction `q` of the way from the node towards
@@ -45,8 +36,7 @@ pub(crate) struct KernelCtx<'a> {
     pub periodic_y: bool,
     pub sides: &'a Sides,
     pub solid: &'a [bool],
-    pub specials: &'a [Special],
-    pub row_start: &'a [u32],
+    pub specials: &'a RowSpecials,
     pub links: &'a [Link],
     pub velocity_scale: f32,
     /// Characteristic (non-reflecting) velocity edges: their reference densities; `None` for
@@ -413,15 +403,14 @@ fn row_body<const OP: u8, const FORCED: bool, const LES: bool, const STREAMED: b
             bulk_row_plain::<OP, FORCED, LES>(c, s, row);
         }
     }
-    let specials = &c.specials[c.row_start[y] as usize..c.row_start[y + 1] as usize];
-    for sp in specials {
+    for sp in c.specials.row(y).1 {
         general_node::<OP, FORCED, LES>(c, src, row, sp.x as usize, y, sp);
     }
 }
 
 /// The same row, every node through the general path (the slow oracle of the tests).
 fn row_reference<const OP: u8, const FORCED: bool, const LES: bool>(c: &KernelCtx, src: &[f32], row: &mut [f32], y: usize) {
-    let specials = &c.specials[c.row_start[y] as usize..c.row_start[y + 1] as usize];
+    let specials = c.specials.row(y).1;
     for x in 0..c.nx {
         let plain = Special {
             x: x as u32,

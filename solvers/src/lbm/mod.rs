@@ -24,6 +24,7 @@ mod part;
 pub(crate) mod probes;
 mod refine;
 mod solver;
+mod specials;
 pub mod sponge;
 pub mod thermal;
 mod units;

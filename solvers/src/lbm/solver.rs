@@ -13,7 +13,7 @@ use super::collision::{equilibrium, moments, Collision, Relax};
 use super::domain::{Edge, Grid, Side, Sides};
 use super::error::LbmError;
 use super::forces::link_forces;
-use super::kernel::{row_fn, KernelCtx, Link, Special};
+use super::kernel::{row_fn, KernelCtx, Link, RowSpecials, Special};
 use super::lattice::{CX, CY, OPP, Q};
 use super::part::Part;
 use super::sponge::{apply_row, Sponge, SpongePlan};
@@ -117,8 +117,7 @@ pub struct D2q9 {
     /// The other half of the A-B pair.
     f_next: AlignedVec,
     solid: Vec<bool>,
-    specials: Vec<Special>,
-    row_start: Vec<u32>,
+    specials: RowSpecials,
     links: Vec<Link>,
     wall_points: Vec<WallPoint>,
     bodies: Vec<Arc<dyn Shape>>,
@@ -146,14 +145,12 @@ impl std::fmt::Debug for D2q9 {
 
 /// The read-only view of the solver that one step's kernel needs (split from `self` so that the
 /// destination array can be borrowed mutably beside it). One argument per field of `self` the
-/// kernel reads: that is the split borrow, so the count is the kernel's inputs, not a design smell.
-#[allow(clippy::too_many_arguments)]
+/// kernel reads: that is the split borrow.
 fn kernel_ctx<'a>(
     cfg: &'a D2q9Config,
     relax: Relax,
     solid: &'a [bool],
-    specials: &'a [Special],
-    row_start: &'a [u32],
+    specials: &'a RowSpecials,
     links: &'a [Link],
     velocity_scale: f32,
     inlet_reference: Option<InletReference>,
@@ -169,7 +166,6 @@ fn kernel_ctx<'a>(
         sides: &cfg.sides,
         solid,
         specials,
-        row_start,
         links,
         velocity_scale,
         inlet_reference,
@@ -371,12 +367,11 @@ impl D2q9 {
             }
         };
         let bulk_row = |yl: usize| local_periodic_y || (yl > 0 && yl + 1 < nyl);
-        let mut specials = Vec::new();
+        let mut specials = RowSpecials::with_rows(nyl);
         let mut links = Vec::new();
         let mut wall_points = Vec::new();
-        let mut row_start = Vec::with_capacity(nyl + 1);
         for yl in 0..nyl {
-            row_start.push(specials.len() as u32);
+            specials.begin_row();
             let y = gy(yl);
             // A ghost row is not stepped (the exchange fills it) and has no links.
             let ghost = !part.owns([0, yl, 0]);
@@ -435,7 +430,7 @@ impl D2q9 {
                 }
             }
         }
-        row_start.push(specials.len() as u32);
+        specials.finish();
 
         let local_solid: Vec<bool> = (0..nyl)
             .flat_map(|yl| solid[gy(yl) * nx..(gy(yl) + 1) * nx].iter().copied())
@@ -451,7 +446,6 @@ impl D2q9 {
             solid: local_solid,
             solid_global,
             specials,
-            row_start,
             links,
             wall_points,
             bodies,
@@ -517,7 +511,6 @@ impl D2q9 {
             self.relax,
             &self.solid,
             &self.specials,
-            &self.row_start,
             &self.links,
             self.velocity_scale,
             self.inlet_reference,
@@ -966,7 +959,6 @@ impl D2q9 {
             self.relax,
             &self.solid,
             &self.specials,
-            &self.row_start,
             &self.links,
             self.velocity_scale,
             self.inlet_reference,

@@ -14,7 +14,7 @@ use rayon::prelude::*;
 use wide::f32x8;
 
 use super::super::collision::Relax;
-pub(crate) use super::super::kernel::Special;
+pub(crate) use super::super::kernel::{RowSpecials, Special};
 use super::super::kernel::{nt_rows_possible, prefetch, store_fence, stream_lines};
 use super::collision::{collide, collide_chunk, moments, Block, Chunk, Ends, CHUNK};
 use super::lattice::Lattice3;
@@ -132,8 +132,8 @@ pub(crate) struct Ctx<'a> {
     pub relax: Relax,
     pub force: [f32; 3],
     pub solid: &'a [bool],
-    pub specials: &'a [Special],
-    pub row_start: &'a [u32],
+    /// The specials of each row `r = z ny + y`.
+    pub specials: &'a RowSpecials,
     /// Rows whose `y` and `z` neighbours all exist: the bulk loop runs there; the other rows
     /// (next to a non-periodic face) are specials from end to end.
     pub row_bulk: &'a [bool],
@@ -194,13 +194,6 @@ impl Ctx<'_> {
         } else {
             profile[FaceMoments::at(self.n, f, p)]
         }
-    }
-
-    /// The specials of row `r = z ny + y`, and the number of the first of them.
-    #[inline(always)]
-    fn row_specials(&self, r: usize) -> (usize, &[Special]) {
-        let first = self.row_start[r] as usize;
-        (first, &self.specials[first..self.row_start[r + 1] as usize])
     }
 
     #[inline(always)]
@@ -337,7 +330,7 @@ fn bulk<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: bo
     buf: &mut [[f32; CHUNK]; Q],
 ) {
     let [nx, ny, _] = c.n;
-    let (first_special, specials) = c.row_specials(z * ny + y);
+    let (first_special, specials) = c.specials.row(z * ny + y);
     // Source rows, and along a periodic x the row's two ends' pulls across it (from the same
     // source rows). Plain loops: `array::from_fn` closures are not inlined here.
     let periodic_x = c.periodic[0];
@@ -451,7 +444,7 @@ fn plane<B: Block, const Q: usize, L: Lattice3<Q>, const OP: u8, const FORCED: b
             bulk::<B, Q, L, OP, FORCED, LES>(c, src, src_ext, y, z, out, &mut buf);
             continue;
         }
-        let (first, specials) = c.row_specials(r);
+        let (first, specials) = c.specials.row(r);
         for (s, sp) in (first..).zip(specials) {
             let g = special::<Q, L, OP, FORCED, LES>(c, src, s, sp, y, z);
             for (i, gi) in g.iter().enumerate() {

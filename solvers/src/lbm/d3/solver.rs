@@ -8,7 +8,7 @@ use super::super::collision::{Collision, Relax, OP_BGK, OP_REG, OP_STREAM};
 use super::super::error::LbmError;
 use super::super::solver::STREAM_STORES_ABOVE_BYTES;
 use super::collision::{collide, equilibrium, moments};
-use super::kernel::{bouzidi, gather, index, plan_pulls, plane_narrow, plane_widest, Ctx, FaceMoments, FacePull, Link, Special, PAD};
+use super::kernel::{bouzidi, gather, index, plan_pulls, plane_narrow, plane_widest, Ctx, FaceMoments, FacePull, Link, RowSpecials, Special, PAD};
 use super::lattice::Lattice3;
 use super::sides::{Face, Faces};
 use super::sponge::{apply_plane, Layers, Sponge3, Sponge3Plan};
@@ -201,8 +201,7 @@ pub struct Lbm3<const Q: usize, L: Lattice3<Q>> {
 /// What the step reads besides the populations, planned once.
 struct Plan {
     solid: Vec<bool>,
-    specials: Vec<Special>,
-    row_start: Vec<u32>,
+    specials: RowSpecials,
     row_bulk: Vec<bool>,
     links: Vec<Link>,
     pulls: Vec<FacePull>,
@@ -225,9 +224,9 @@ impl Plan {
         let (none, uniform) = (FaceMoments::default(), Default::default());
         let c = ctx::<Q>(cfg, self, &none, &uniform, Relax::new(cfg.tau, 0.0), 1.0, Layers(&[]));
         let [_, ny, _] = cfg.n;
-        for r in 0..self.row_start.len() - 1 {
+        for r in 0..self.specials.rows() {
             let (y, z) = (r % ny, r / ny);
-            for sp in &self.specials[self.row_start[r] as usize..self.row_start[r + 1] as usize] {
+            for sp in self.specials.row(r).1 {
                 pull_start.push(pulls.len() as u32);
                 if !sp.solid {
                     plan_pulls::<Q, L>(&c, [sp.x as usize, y, z], &mut pulls);
@@ -259,7 +258,6 @@ fn ctx<'a, const Q: usize>(
         force: cfg.body_force.map(|v| v as f32),
         solid: &plan.solid,
         specials: &plan.specials,
-        row_start: &plan.row_start,
         row_bulk: &plan.row_bulk,
         links: &plan.links,
         pulls: &plan.pulls,
@@ -395,13 +393,12 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
             }
             Some(s)
         };
-        let mut specials = Vec::new();
+        let mut specials = RowSpecials::with_rows(ny * nz);
         let mut links = Vec::new();
-        let mut row_start = Vec::with_capacity(ny * nz + 1);
         let mut row_bulk = Vec::with_capacity(ny * nz);
         for z in 0..nz {
             for y in 0..ny {
-                row_start.push(specials.len() as u32);
+                specials.begin_row();
                 let at_face = |v: usize, n: usize, a: usize| !periodic[a] && (v == 0 || v + 1 == n);
                 let bulk = !at_face(y, ny, 1) && !at_face(z, nz, 2);
                 row_bulk.push(bulk);
@@ -444,11 +441,10 @@ impl<const Q: usize, L: Lattice3<Q>> Lbm3<Q, L> {
                 }
             }
         }
-        row_start.push(specials.len() as u32);
+        specials.finish();
         let mut plan = Plan {
             solid,
             specials,
-            row_start,
             row_bulk,
             links,
             pulls: Vec::new(),
