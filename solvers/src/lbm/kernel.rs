@@ -10,7 +10,7 @@ use super::boundary::{bouzidi, side_value, InletReference};
 use super::collision::{collide_les, Collision, Relax, OP_BGK, OP_REG, OP_RR};
 use super::domain::Sides;
 use super::lattice::{CX, CY, Q};
-pub(crate) use super::specials::{RowSpecials, Special};
+use super::specials::{RowSpecials, Special};
 
 /// A lattice link from fluid node `cell` whose streaming source in direction `k` (the node
 /// `cell - c_k`) is inside a body; the wall is at fraction `q` of the way from the node towards

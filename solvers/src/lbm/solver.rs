@@ -13,9 +13,10 @@ use super::collision::{equilibrium, moments, Collision, Relax};
 use super::domain::{Edge, Grid, Side, Sides};
 use super::error::LbmError;
 use super::forces::link_forces;
-use super::kernel::{row_fn, KernelCtx, Link, RowSpecials, Special};
+use super::kernel::{row_fn, KernelCtx, Link};
 use super::lattice::{CX, CY, OPP, Q};
 use super::part::Part;
+use super::specials::{RowSpecials, Special};
 use super::sponge::{apply_row, Sponge, SpongePlan};
 use crate::geometry::Shape;
 

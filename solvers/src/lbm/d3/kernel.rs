@@ -14,8 +14,8 @@ use rayon::prelude::*;
 use wide::f32x8;
 
 use super::super::collision::Relax;
-pub(crate) use super::super::kernel::{RowSpecials, Special};
 use super::super::kernel::{nt_rows_possible, prefetch, store_fence, stream_lines};
+use super::super::specials::{RowSpecials, Special};
 use super::collision::{collide, collide_chunk, moments, Block, Chunk, Ends, CHUNK};
 use super::lattice::Lattice3;
 use super::sides::{face_source, face_value, face_value_planned, plan_face_pull, Faces};
