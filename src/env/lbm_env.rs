@@ -275,7 +275,7 @@ impl LbmEnv {
     /// up (`reset` then copies it into the solver from there, once).
     fn develop(&mut self) -> Result<(), EnvError> {
         if self.attractor.is_none() {
-            let want = self.solver.populations().len() + self.thermal.as_ref().map_or(0, |t| t.populations().len());
+            let want = self.solver.population_count() + self.thermal.as_ref().map_or(0, |t| t.populations().len());
             let cached = self.cache_file().and_then(|p| super::spin_up::load_state(&p, want));
             // Under MPI the ranks spin up together unless every one of them has its slab cached.
             self.attractor = if self.solver.all_ranks(cached.is_some()) {
@@ -393,7 +393,7 @@ impl Env for LbmEnv {
     fn reset(&mut self, seed: u64) -> Result<(Vec<f64>, Info), EnvError> {
         self.develop()?;
         let state = self.attractor.as_deref().unwrap_or_default();
-        let n_flow = self.solver.populations().len();
+        let n_flow = self.solver.population_count();
         // An oscillating inflow continues its phase from the end of the spin-up.
         let time = if self.spec.inflow.is_some() {
             self.units.steps(self.spec.spin_up)

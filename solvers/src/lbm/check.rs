@@ -1,7 +1,7 @@
 //! Blow-up detection: per-row extremes of density and speed, and the first NaN.
 
 use super::collision::moments;
-use super::lattice::Q;
+use super::post::Post;
 
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct RowStat {
@@ -12,7 +12,7 @@ pub(crate) struct RowStat {
     pub u2_max: (f32, usize),
 }
 
-pub(crate) fn scan_row(f: &[f32], solid: &[bool], nx: usize, y: usize) -> RowStat {
+pub(crate) fn scan_row(f: &Post, solid: &[bool], nx: usize, y: usize) -> RowStat {
     let mut st = RowStat {
         nan_at: None,
         rho_min: (f32::INFINITY, 0),
@@ -23,10 +23,7 @@ pub(crate) fn scan_row(f: &[f32], solid: &[bool], nx: usize, y: usize) -> RowSta
         if solid[y * nx + x] {
             continue;
         }
-        let mut g = [0.0f32; Q];
-        for (i, gi) in g.iter_mut().enumerate() {
-            *gi = f[(y * Q + i) * nx + x];
-        }
+        let g = f.node(x, y);
         if g.iter().any(|v| !v.is_finite()) {
             st.nan_at = Some(x);
             return st;

@@ -18,11 +18,12 @@
 
 use super::boundary::bouzidi;
 use super::kernel::KernelCtx;
-use super::lattice::{CX, CY, OPP, Q};
+use super::lattice::{CX, CY, OPP};
+use super::post::Post;
 
 /// Each link's exchange, in link order, into `partial[(body * rows + row) * 2 + a]`, `row` the
 /// global row `global_row(y)` of the link's node.
-pub(crate) fn link_forces(c: &KernelCtx, src: &[f32], global_row: impl Fn(usize) -> usize, rows: usize, partial: &mut [f64]) {
+pub(crate) fn link_forces(c: &KernelCtx, src: &Post, global_row: impl Fn(usize) -> usize, rows: usize, partial: &mut [f64]) {
     partial.iter_mut().for_each(|f| *f = 0.0);
     let nx = c.nx;
     for l in c.links {
@@ -30,7 +31,7 @@ pub(crate) fn link_forces(c: &KernelCtx, src: &[f32], global_row: impl Fn(usize)
         let y = l.cell as usize / nx;
         let k = l.k as usize;
         let i = OPP[k];
-        let out = src[(y * Q + i) * nx + x] as f64;
+        let out = src.at(x, y, i) as f64;
         let back = bouzidi(c, src, x, y, l) as f64;
         let (ci, ck) = ([CX[i] as f64, CY[i] as f64], [CX[k] as f64, CY[k] as f64]);
         let uw = [l.uw[0] as f64, l.uw[1] as f64];

@@ -10,6 +10,7 @@ use super::boundary::{bouzidi, side_value, InletReference};
 use super::collision::{collide_les, Collision, Relax, OP_BGK, OP_REG, OP_RR};
 use super::domain::Sides;
 use super::lattice::{CX, CY, Q};
+use super::post::{Frame, Post};
 use super::specials::{RowSpecials, Special};
 
 /// A lattice link from fluid node `cell` whose streaming source in direction `k` (the node
@@ -44,15 +45,11 @@ pub(crate) struct KernelCtx<'a> {
     pub inlet_reference: Option<InletReference>,
     /// Write the interior with non-temporal stores (arrays larger than the caches).
     pub stream_stores: bool,
+    /// Size and periodicity, for reading populations through [`Post`].
+    pub frame: Frame,
 }
 
 impl KernelCtx<'_> {
-    /// Index of population `i` of node `(x, y)`.
-    #[inline(always)]
-    pub fn idx(&self, x: usize, y: usize, i: usize) -> usize {
-        (y * Q + i) * self.nx + x
-    }
-
     /// `v` wrapped into `0..n` on a periodic axis, `None` if outside a non-periodic one.
     #[inline]
     fn wrap(v: isize, n: usize, periodic: bool) -> Option<usize> {
@@ -104,7 +101,7 @@ pub(crate) fn nt_rows_possible(row: &[f32], nx: usize) -> bool {
 /// nine read streams plus nine written ones are more than the hardware prefetchers keep ahead
 /// of (D2Q9 4096^2: about 5 % faster, measured interleaved).
 #[inline(always)]
-fn collide_run<const OP: u8, const FORCED: bool, const LES: bool, const PREFETCH: bool>(
+pub(crate) fn collide_run<const OP: u8, const FORCED: bool, const LES: bool, const PREFETCH: bool>(
     c: &KernelCtx,
     src: [&[f32]; Q],
     dst: [&mut [f32]; Q],
@@ -440,11 +437,23 @@ fn general_node<const OP: u8, const FORCED: bool, const LES: bool>(
         }
         return;
     }
+    let mut g = gather(c, &Post::canonical(src, c.frame), x, y, sp);
+    collide_les::<OP, FORCED, LES>(&mut g, c.relax, c.fx, c.fy);
+    for i in 0..Q {
+        row[i * nx + x] = g[i];
+    }
+}
+
+/// The populations arriving at fluid node `(x, y)`, `f_k(x) = f*_k(x - c_k)`, with the
+/// boundaries applied where `x - c_k` is solid (the node's links) or beyond an edge.
+#[inline]
+pub(crate) fn gather(c: &KernelCtx, src: &Post, x: usize, y: usize, sp: &Special) -> [f32; Q] {
+    let nx = c.nx;
     let mut g = [0.0f32; Q];
     let mut missing = [false; Q];
     for k in 0..Q {
         match c.neighbour(x, y, -CX[k], -CY[k]) {
-            Some((xs, ys)) if !c.solid[ys * nx + xs] => g[k] = src[c.idx(xs, ys, k)],
+            Some((xs, ys)) if !c.solid[ys * nx + xs] => g[k] = src.at(xs, ys, k),
             _ => missing[k] = true,
         }
     }
@@ -458,10 +467,7 @@ fn general_node<const OP: u8, const FORCED: bool, const LES: bool>(
             g[k] = side_value(c, src, x, y, k);
         }
     }
-    collide_les::<OP, FORCED, LES>(&mut g, c.relax, c.fx, c.fy);
-    for i in 0..Q {
-        row[i * nx + x] = g[i];
-    }
+    g
 }
 
 #[cfg(test)]

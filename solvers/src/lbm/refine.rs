@@ -39,6 +39,7 @@
 
 use std::sync::Arc;
 
+use super::aa::Propagation;
 use super::collision::{add_third_and_fourth_order, hermite_populations, hermite_stress, Collision};
 use super::domain::{Edge, Grid, Sides};
 use super::error::LbmError;
@@ -172,9 +173,18 @@ impl Refined {
             fine.stream_stores = parent.stream_stores;
             cfgs.push(fine);
         }
+        // The coupling reads and rewrites canonical rows (`D2q9::row`, `rewrite_rows`).
         let levels = cfgs
             .into_iter()
-            .map(|c| D2q9::new(c, bodies.clone()))
+            .map(|c| {
+                D2q9::new(
+                    D2q9Config {
+                        propagation: Some(Propagation::Pull),
+                        ..c
+                    },
+                    bodies.clone(),
+                )
+            })
             .collect::<Result<Vec<_>, _>>()?;
 
         let finest = &levels[levels.len() - 1];

@@ -1,11 +1,13 @@
 //! The D2Q9 solver: construction (plan once) and the step (execute many, no allocation).
 
+use std::borrow::Cow;
 use std::sync::Arc;
 
 use rayon::prelude::*;
 
 use crate::comm::{Comm, Solo};
 
+use super::aa::{aa_row_fn, canonical_into, gather_specials, swap_directions, Cells, Propagation};
 use super::aligned::AlignedVec;
 use super::boundary::InletReference;
 use super::check::{scan_row, RowStat};
@@ -16,6 +18,7 @@ use super::forces::link_forces;
 use super::kernel::{row_fn, KernelCtx, Link};
 use super::lattice::{CX, CY, OPP, Q};
 use super::part::Part;
+use super::post::{Form, Frame, Loc, Post};
 use super::specials::{RowSpecials, Special};
 use super::sponge::{apply_row, Sponge, SpongePlan};
 use crate::geometry::Shape;
@@ -63,6 +66,11 @@ pub struct D2q9Config {
     /// [`super::boundary::InletReference`]), its reference density averaged over this many
     /// steps; `None` (the default) keeps the rigid velocity edge.
     pub characteristic_inlet: Option<f64>,
+    /// How the fast kernel streams: `None` decides by size (the AA pattern where the arrays are
+    /// larger than the caches, as for `stream_stores`; pulling in cache, where it measured
+    /// faster). A grid split over ranks always pulls. A performance knob only: results are
+    /// bitwise the same.
+    pub propagation: Option<Propagation>,
 }
 
 impl D2q9Config {
@@ -83,6 +91,7 @@ impl D2q9Config {
             stream_stores: None,
             sponges: Vec::new(),
             characteristic_inlet: None,
+            propagation: None,
         }
     }
 }
@@ -113,10 +122,18 @@ pub struct D2q9 {
     partial: Vec<f64>,
     summed: Vec<f64>,
     relax: Relax,
-    /// Current post-collision populations, shifted (`g = f - w`), row-blocked SoA.
+    /// Current post-collision populations, shifted (`g = f - w`), row-blocked SoA, laid out as
+    /// `form` says (see [`super::post`]).
     f: AlignedVec,
-    /// The other half of the A-B pair.
+    /// The other half of the A-B pair (pull), or scratch for changes of form (AA).
     f_next: AlignedVec,
+    form: Form,
+    /// Streamed form: the values that leave through non-periodic edges (empty when pulling).
+    halo: Vec<f32>,
+    /// AA: each special's arriving populations, gathered before the sweep (empty when pulling).
+    stash: Vec<f32>,
+    /// Step with the AA pattern ([`super::aa`]) rather than the pull kernel.
+    aa: bool,
     solid: Vec<bool>,
     specials: RowSpecials,
     links: Vec<Link>,
@@ -171,6 +188,17 @@ fn kernel_ctx<'a>(
         velocity_scale,
         inlet_reference,
         stream_stores: cfg.stream_stores.unwrap_or(cfg.nx * cfg.ny * Q * 4 * 2 > STREAM_STORES_ABOVE_BYTES),
+        frame: frame_of(cfg),
+    }
+}
+
+/// The grid's size and periodicity (this rank's rows).
+fn frame_of(cfg: &D2q9Config) -> Frame {
+    Frame {
+        nx: cfg.nx,
+        ny: cfg.ny,
+        periodic_x: cfg.sides.west == Side::Periodic,
+        periodic_y: cfg.sides.south == Side::Periodic,
     }
 }
 
@@ -440,10 +468,16 @@ impl D2q9 {
         let relax = Relax::new(cfg.tau, cfg.smagorinsky);
         let n_bodies = bodies.len();
         let sums = n_bodies * ny * 2;
+        let large = cfg.nx * cfg.ny * Q * 4 * 2 > STREAM_STORES_ABOVE_BYTES;
+        let aa = cfg.propagation.unwrap_or(if large { Propagation::Aa } else { Propagation::Pull }) == Propagation::Aa && !part.is_split();
         let mut solver = D2q9 {
             relax,
             f: AlignedVec::zeros(nx * nyl * Q),
             f_next: AlignedVec::zeros(nx * nyl * Q),
+            form: Form::Canonical,
+            halo: if aa { vec![0.0; frame_of(&cfg).halo_len()] } else { Vec::new() },
+            stash: if aa { vec![0.0; specials.len() * Q] } else { Vec::new() },
+            aa,
             solid: local_solid,
             solid_global,
             specials,
@@ -492,21 +526,56 @@ impl D2q9 {
             }
         }
         self.f_next.copy_from_slice(&self.f);
+        self.form = Form::Canonical;
         self.time = 0;
+        let post = Post::canonical(&self.f, frame_of(&self.cfg));
         if let Some(r) = &mut self.inlet_reference {
-            r.reset(&self.cfg.sides, &self.f, &self.solid, nx, nyl);
+            r.reset(&self.cfg.sides, &post, &self.solid, nx, nyl);
         }
+    }
+
+    /// The current post-collision populations, whatever their form.
+    fn post(&self) -> Post<'_> {
+        Post {
+            f: &self.f,
+            halo: &self.halo,
+            form: self.form,
+            frame: frame_of(&self.cfg),
+        }
+    }
+
+    /// Brings the populations to the canonical form (slot `(x, i)` holds `f*_i(x)`).
+    fn canonicalize(&mut self) {
+        match self.form {
+            Form::Canonical => {}
+            Form::Swapped => swap_directions(&mut self.f, self.cfg.nx),
+            Form::Streamed => {
+                let post = Post {
+                    f: &self.f,
+                    halo: &self.halo,
+                    form: self.form,
+                    frame: frame_of(&self.cfg),
+                };
+                canonical_into(&post, &mut self.f_next);
+                std::mem::swap(&mut self.f, &mut self.f_next);
+            }
+        }
+        self.form = Form::Canonical;
     }
 
     /// Advances the characteristic inlets' reference densities by one step (if there are any).
     fn update_inlet_reference(&mut self) {
-        if let Some(r) = &mut self.inlet_reference {
-            r.update(&self.cfg.sides, &self.f, &self.solid, self.cfg.nx, self.cfg.ny);
+        if let Some(mut r) = self.inlet_reference {
+            r.update(&self.cfg.sides, &self.post(), &self.solid, self.cfg.nx, self.cfg.ny);
+            self.inlet_reference = Some(r);
         }
     }
 
     /// Advances one time step (every rank together). Allocates nothing.
     pub fn step(&mut self) -> Result<(), LbmError> {
+        if self.aa {
+            return self.step_aa();
+        }
         let ctx = kernel_ctx(
             &self.cfg,
             self.relax,
@@ -528,14 +597,57 @@ impl D2q9 {
                 apply_row(sponges, row, part.global_index(y), nx, ny, &solid[y * nx..(y + 1) * nx]);
             }
         });
-        link_forces(&ctx, src, |y| part.global_index(y), ny, &mut self.partial);
+        link_forces(
+            &ctx,
+            &Post::canonical(src, ctx.frame),
+            |y| part.global_index(y),
+            ny,
+            &mut self.partial,
+        );
+        std::mem::swap(&mut self.f, &mut self.f_next);
+        self.finish_step()
+    }
+
+    /// One step of the AA pattern (one process): the specials' arriving populations and the
+    /// link forces from the previous values, then every row in place (see [`super::aa`]).
+    fn step_aa(&mut self) -> Result<(), LbmError> {
+        if self.form == Form::Canonical {
+            swap_directions(&mut self.f, self.cfg.nx);
+            self.form = Form::Swapped;
+        }
+        let ctx = kernel_ctx(
+            &self.cfg,
+            self.relax,
+            &self.solid,
+            &self.specials,
+            &self.links,
+            self.velocity_scale,
+            self.inlet_reference,
+        );
+        let post = Post {
+            f: &self.f,
+            halo: &self.halo,
+            form: self.form,
+            frame: ctx.frame,
+        };
+        gather_specials(&ctx, &post, &mut self.stash);
+        link_forces(&ctx, &post, |y| y, self.cfg.ny, &mut self.partial);
+        let odd = self.form == Form::Swapped;
+        let forced = self.cfg.body_force != [0.0, 0.0];
+        let kernel = aa_row_fn(self.cfg.collision, forced, self.cfg.smagorinsky > 0.0);
+        let cells = Cells::new(&mut self.f, &mut self.halo);
+        let (stash, sponges) = (&self.stash, &self.sponges);
+        (0..self.cfg.ny)
+            .into_par_iter()
+            .with_min_len(4)
+            .for_each(|y| kernel(&ctx, &cells, stash, sponges, y, odd));
+        self.form = if odd { Form::Streamed } else { Form::Swapped };
         self.finish_step()
     }
 
     /// The rest of a step after the kernel: the ghost rows, the forces summed over the ranks,
     /// the characteristic inlet, and the blow-up checks.
     fn finish_step(&mut self) -> Result<(), LbmError> {
-        std::mem::swap(&mut self.f, &mut self.f_next);
         self.exchange();
         self.time += 1;
         self.update_inlet_reference();
@@ -568,10 +680,16 @@ impl D2q9 {
     /// Scans every node for NaN, density out of `rho_bounds` or speed above `u_max`; reports the
     /// first bad node in row order (the same on every rank).
     pub fn check(&mut self) -> Result<(), LbmError> {
-        let (nx, f, solid, part) = (self.cfg.nx, &self.f, &self.solid, &self.part);
+        let post = Post {
+            f: &self.f,
+            halo: &self.halo,
+            form: self.form,
+            frame: frame_of(&self.cfg),
+        };
+        let (nx, solid, part) = (self.cfg.nx, &self.solid, &self.part);
         self.row_stats.par_iter_mut().enumerate().for_each(|(y, st)| {
             *st = if part.owns([0, y, 0]) {
-                scan_row(f, solid, nx, y)
+                scan_row(&post, solid, nx, y)
             } else {
                 RowStat::default()
             };
@@ -764,13 +882,8 @@ impl D2q9 {
     /// Density and velocity of node `(x, y)` of the whole grid (lattice units); on a split grid
     /// the node must be on this rank's rows (owned or ghost).
     pub fn node(&self, x: usize, y: usize) -> (f32, f32, f32) {
-        let nx = self.cfg.nx;
         let y = self.local_row(y).expect("node: a row this rank does not hold");
-        let mut g = [0.0f32; Q];
-        for (i, gi) in g.iter_mut().enumerate() {
-            *gi = self.f[(y * Q + i) * nx + x];
-        }
-        self.density_velocity(&g)
+        self.density_velocity(&self.post().node(x, y))
     }
 
     /// The nine shifted post-collision populations `g_i = f_i* - w_i` of node `(x, y)`.
@@ -779,17 +892,19 @@ impl D2q9 {
     /// split grid they would address this rank's rows, and they are refused there.
     pub fn node_populations(&self, x: usize, y: usize) -> [f32; Q] {
         assert!(!self.part.is_split(), "grid coupling on a split grid");
-        let nx = self.cfg.nx;
-        std::array::from_fn(|i| self.f[(y * Q + i) * nx + x])
+        self.post().node(x, y)
     }
 
     /// Overwrites the shifted post-collision populations of node `(x, y)` (grid coupling: the
     /// next step streams them like any other node's). Allocates nothing.
     pub fn set_node_populations(&mut self, x: usize, y: usize, g: &[f32; Q]) {
         assert!(!self.part.is_split(), "grid coupling on a split grid");
-        let nx = self.cfg.nx;
+        let frame = frame_of(&self.cfg);
         for (i, v) in g.iter().enumerate() {
-            self.f[(y * Q + i) * nx + x] = *v;
+            match frame.locate(self.form, x, y, i) {
+                Loc::Grid(k) => self.f[k] = *v,
+                Loc::Halo(k) => self.halo[k] = *v,
+            }
         }
     }
 
@@ -800,6 +915,7 @@ impl D2q9 {
     /// the same for any thread count. Allocates nothing.
     pub fn rewrite_rows(&mut self, ys: std::ops::Range<usize>, rewrite: impl Fn(usize, &[bool], &mut [f32]) + Sync) {
         assert!(!self.part.is_split(), "grid coupling on a split grid");
+        self.canonicalize();
         let nx = self.cfg.nx;
         let (solid, y0, ny) = (&self.solid, ys.start, ys.len());
         self.f.par_chunks_mut(Q * nx).skip(y0).take(ny).enumerate().for_each(|(k, row)| {
@@ -809,8 +925,13 @@ impl D2q9 {
     }
 
     /// Row `y`'s solid flags (`[x]`) and shifted post-collision populations (`[i * nx + x]`).
+    /// Needs the pull propagation ([`D2q9Config::propagation`]), which keeps rows canonical.
     pub fn row(&self, y: usize) -> (&[bool], &[f32]) {
         assert!(!self.part.is_split(), "grid coupling on a split grid");
+        assert!(
+            self.form == Form::Canonical,
+            "row: the AA pattern holds rows in another form; couple grids with propagation = Pull"
+        );
         let nx = self.cfg.nx;
         (&self.solid[y * nx..(y + 1) * nx], &self.f[y * Q * nx..(y + 1) * Q * nx])
     }
@@ -831,6 +952,7 @@ impl D2q9 {
     pub fn macroscopic(&self, rho: &mut [f32], ux: &mut [f32], uy: &mut [f32]) {
         let nx = self.cfg.nx;
         let part = &self.part;
+        let post = self.post();
         rho.par_chunks_mut(nx)
             .zip(ux.par_chunks_mut(nx))
             .zip(uy.par_chunks_mut(nx))
@@ -844,11 +966,8 @@ impl D2q9 {
                     v.fill(0.0);
                     return;
                 };
-                // Row `yl` holds the nine direction rows one after another.
-                let rows = &self.f[yl * Q * nx..(yl + 1) * Q * nx];
                 for x in 0..nx.min(r.len()) {
-                    let g: [f32; Q] = std::array::from_fn(|i| rows[i * nx + x]);
-                    (r[x], u[x], v[x]) = self.density_velocity(&g);
+                    (r[x], u[x], v[x]) = self.density_velocity(&post.node(x, yl));
                 }
             });
         if self.part.is_split() {
@@ -869,7 +988,8 @@ impl D2q9 {
             .filter(|&y| self.part.owns([0, y, 0]))
             .flat_map(|y| (0..nx).map(move |x| (x, y)))
             .filter(|&(x, y)| !self.solid[y * nx + x]);
-        self.split_sum(fluid.map(|(x, y)| (y, 1.0 + (0..Q).map(|i| self.f[(y * Q + i) * nx + x] as f64).sum::<f64>())))
+        let post = self.post();
+        self.split_sum(fluid.map(|(x, y)| (y, 1.0 + post.node(x, y).iter().map(|&g| g as f64).sum::<f64>())))
     }
 
     /// The sum of `terms` (this rank's row, value), bitwise the same on any number of ranks: per
@@ -933,9 +1053,23 @@ impl D2q9 {
         }
     }
 
-    /// Raw shifted populations (row-blocked SoA, see the crate docs); for tests and checkpoints.
-    pub fn populations(&self) -> &[f32] {
-        &self.f
+    /// The shifted post-collision populations in the canonical row-blocked SoA (see the crate
+    /// docs; slot `(x, i)` holds `f*_i(x)`); for tests and checkpoints. Borrowed when the
+    /// array holds them so, else converted.
+    pub fn populations(&self) -> Cow<'_, [f32]> {
+        match self.form {
+            Form::Canonical => Cow::Borrowed(&self.f),
+            _ => {
+                let mut f = vec![0.0; self.f.len()];
+                canonical_into(&self.post(), &mut f);
+                Cow::Owned(f)
+            }
+        }
+    }
+
+    /// How many values [`Self::populations`] holds.
+    pub fn population_count(&self) -> usize {
+        self.f.len()
     }
 
     /// Overwrites the populations (e.g. from a checkpoint) and sets the step counter.
@@ -947,6 +1081,7 @@ impl D2q9 {
             ));
         }
         self.f.copy_from_slice(f);
+        self.form = Form::Canonical;
         self.time = time;
         Ok(())
     }
@@ -955,6 +1090,7 @@ impl D2q9 {
     /// (no bulk/special split, no vectorisation), single-threaded.
     #[doc(hidden)]
     pub fn step_reference(&mut self) -> Result<(), LbmError> {
+        self.canonicalize();
         let ctx = kernel_ctx(
             &self.cfg,
             self.relax,
@@ -974,7 +1110,14 @@ impl D2q9 {
                 apply_row(&self.sponges, row, part.global_index(y), nx, ny, &self.solid[y * nx..(y + 1) * nx]);
             }
         }
-        link_forces(&ctx, &self.f, |y| part.global_index(y), ny, &mut self.partial);
+        link_forces(
+            &ctx,
+            &Post::canonical(&self.f, ctx.frame),
+            |y| part.global_index(y),
+            ny,
+            &mut self.partial,
+        );
+        std::mem::swap(&mut self.f, &mut self.f_next);
         self.finish_step()
     }
 

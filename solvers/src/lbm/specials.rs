@@ -52,6 +52,16 @@ impl RowSpecials {
         self.list.len()
     }
 
+    /// Every special, in row order (a special's number is its index here).
+    pub fn list(&self) -> &[Special] {
+        &self.list
+    }
+
+    /// The row of special number `j`.
+    pub fn row_of(&self, j: usize) -> usize {
+        self.start.partition_point(|&s| s as usize <= j) - 1
+    }
+
     /// The specials of row `r`, and the number of the first of them.
     #[inline(always)]
     pub fn row(&self, r: usize) -> (usize, &[Special]) {
@@ -88,5 +98,6 @@ mod tests {
         assert_eq!(xs(0), (0, vec![0, 7]));
         assert_eq!(xs(1), (2, vec![]));
         assert_eq!(xs(2), (2, vec![3]));
+        assert_eq!((0..3).map(|j| s.row_of(j)).collect::<Vec<_>>(), [0, 0, 2]);
     }
 }

@@ -80,19 +80,35 @@ impl SpongePlan {
 /// rank's slab); `solid_row[x]` marks the row's solid nodes, which are left alone. Allocates
 /// nothing.
 pub(crate) fn apply_row(plans: &[SpongePlan], row: &mut [f32], y: usize, nx: usize, ny: usize, solid_row: &[bool]) {
+    apply_span(plans, row, nx, 0..nx, y, nx, ny, solid_row);
+}
+
+/// [`apply_row`] on the nodes `span` of row `y` only, node `x`'s population `i` at
+/// `values[i * stride + x - span.start]`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn apply_span(
+    plans: &[SpongePlan],
+    values: &mut [f32],
+    stride: usize,
+    span: std::ops::Range<usize>,
+    y: usize,
+    nx: usize,
+    ny: usize,
+    solid_row: &[bool],
+) {
     for p in plans.iter().filter(|p| p.touches_row(y, ny)) {
         let xs = match p.edge {
             Edge::West => 0..p.width.min(nx),
             Edge::East => nx.saturating_sub(p.width)..nx,
             Edge::South | Edge::North => 0..nx,
         };
-        for x in xs {
+        for x in xs.start.max(span.start)..xs.end.min(span.end) {
             let s = p.sigma(x, y, nx, ny);
             if s == 0.0 || solid_row[x] {
                 continue;
             }
             for (i, e) in p.g_eq.iter().enumerate() {
-                let g = &mut row[i * nx + x];
+                let g = &mut values[i * stride + x - span.start];
                 *g -= s * (*g - e);
             }
         }

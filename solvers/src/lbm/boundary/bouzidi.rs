@@ -13,21 +13,22 @@
 
 use super::super::kernel::{KernelCtx, Link};
 use super::super::lattice::{CX, CY, OPP, W};
+use super::super::post::Post;
 
 #[inline]
-pub(crate) fn bouzidi(c: &KernelCtx, src: &[f32], x: usize, y: usize, l: &Link) -> f32 {
+pub(crate) fn bouzidi(c: &KernelCtx, src: &Post, x: usize, y: usize, l: &Link) -> f32 {
     let k = l.k as usize;
     let i = OPP[k];
     let q = l.q;
     let moving = 6.0 * W[k] * (CX[k] as f32 * l.uw[0] + CY[k] as f32 * l.uw[1]);
-    let gi = src[c.idx(x, y, i)];
+    let gi = src.at(x, y, i);
     if q < 0.5 {
         match c.fluid_neighbour(x, y, CX[k], CY[k]) {
-            Some((xb, yb)) => 2.0 * q * gi + (1.0 - 2.0 * q) * src[c.idx(xb, yb, i)] + moving,
+            Some((xb, yb)) => 2.0 * q * gi + (1.0 - 2.0 * q) * src.at(xb, yb, i) + moving,
             None => gi + moving,
         }
     } else {
-        let gk = src[c.idx(x, y, k)];
+        let gk = src.at(x, y, k);
         (gi + (2.0 * q - 1.0) * gk + moving) / (2.0 * q)
     }
 }

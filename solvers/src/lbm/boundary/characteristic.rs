@@ -22,7 +22,7 @@
 
 use super::super::collision::moments;
 use super::super::domain::{Edge, Side, Sides};
-use super::super::lattice::Q;
+use super::super::post::Post;
 
 /// `c_s`, the lattice speed of sound.
 const CS: f32 = 0.577_350_3;
@@ -69,7 +69,7 @@ impl InletReference {
     }
 
     /// Sets each velocity edge's reference to its current mean density (after an initialisation).
-    pub(crate) fn reset(&mut self, sides: &Sides, f: &[f32], solid: &[bool], nx: usize, ny: usize) {
+    pub(crate) fn reset(&mut self, sides: &Sides, f: &Post, solid: &[bool], nx: usize, ny: usize) {
         for edge in [Edge::West, Edge::East, Edge::South, Edge::North] {
             if let Some(mean) = edge_mean_density(sides, edge, f, solid, nx, ny) {
                 self.rho[edge_index(edge)] = mean;
@@ -79,7 +79,7 @@ impl InletReference {
 
     /// One step of the moving average: `rho_ref += (mean - rho_ref) / T` on each velocity edge.
     /// Serial and in a fixed order, so bitwise the same for any thread count. Allocates nothing.
-    pub(crate) fn update(&mut self, sides: &Sides, f: &[f32], solid: &[bool], nx: usize, ny: usize) {
+    pub(crate) fn update(&mut self, sides: &Sides, f: &Post, solid: &[bool], nx: usize, ny: usize) {
         for edge in [Edge::West, Edge::East, Edge::South, Edge::North] {
             if let Some(mean) = edge_mean_density(sides, edge, f, solid, nx, ny) {
                 let r = &mut self.rho[edge_index(edge)];
@@ -89,9 +89,8 @@ impl InletReference {
     }
 }
 
-/// Mean density of the fluid nodes along `edge` if it is a velocity edge (row-blocked SoA `f`,
-/// shifted populations).
-fn edge_mean_density(sides: &Sides, edge: Edge, f: &[f32], solid: &[bool], nx: usize, ny: usize) -> Option<f32> {
+/// Mean density of the fluid nodes along `edge` if it is a velocity edge (shifted populations).
+fn edge_mean_density(sides: &Sides, edge: Edge, f: &Post, solid: &[bool], nx: usize, ny: usize) -> Option<f32> {
     if !matches!(sides.get(edge), Side::Velocity { .. }) {
         return None;
     }
@@ -110,11 +109,7 @@ fn edge_mean_density(sides: &Sides, edge: Edge, f: &[f32], solid: &[bool], nx: u
         if solid[y * nx + x] {
             continue;
         }
-        let mut g = [0.0f32; Q];
-        for (i, gi) in g.iter_mut().enumerate() {
-            *gi = f[(y * Q + i) * nx + x];
-        }
-        sum += 1.0 + moments(&g).0 as f64;
+        sum += 1.0 + moments(&f.node(x, y)).0 as f64;
         n += 1;
     }
     (n > 0).then(|| (sum / n as f64) as f32)

@@ -5,10 +5,11 @@ use super::super::collision::moments;
 use super::super::domain::{Edge, Side};
 use super::super::kernel::KernelCtx;
 use super::super::lattice::{CX, CY, OPP, Q, W};
+use super::super::post::Post;
 
 /// Value entering node `(x, y)` in direction `k` from outside the domain.
 #[inline]
-pub(crate) fn side_value(c: &KernelCtx, src: &[f32], x: usize, y: usize, k: usize) -> f32 {
+pub(crate) fn side_value(c: &KernelCtx, src: &Post, x: usize, y: usize, k: usize) -> f32 {
     let xs = x as isize - CX[k] as isize;
     let ys = y as isize - CY[k] as isize;
     let out_x = if c.periodic_x {
@@ -41,11 +42,11 @@ pub(crate) fn side_value(c: &KernelCtx, src: &[f32], x: usize, y: usize, k: usiz
         (Some(e), None) | (None, Some(e)) => e,
         // Not outside the domain: a solid source without a link cannot happen (every solid
         // source of a fluid node gets a link); bounce back to stay safe.
-        (None, None) => return src[c.idx(x, y, OPP[k])],
+        (None, None) => return src.at(x, y, OPP[k]),
     };
     match c.sides.get(edge) {
-        Side::Periodic => src[c.idx(x, y, OPP[k])],
-        Side::Wall => src[c.idx(x, y, OPP[k])],
+        Side::Periodic => src.at(x, y, OPP[k]),
+        Side::Wall => src.at(x, y, OPP[k]),
         Side::Velocity { profile } => {
             let along = match edge {
                 Edge::West | Edge::East => y,
@@ -55,14 +56,14 @@ pub(crate) fn side_value(c: &KernelCtx, src: &[f32], x: usize, y: usize, k: usiz
             let (ux, uy) = (u[0] * c.velocity_scale, u[1] * c.velocity_scale);
             let mut g = [0.0f32; Q];
             for (i, gi) in g.iter_mut().enumerate() {
-                *gi = src[c.idx(x, y, i)];
+                *gi = src.at(x, y, i);
             }
             let rho = 1.0 + moments(&g).0;
             let (ux, uy) = match &c.inlet_reference {
                 Some(r) => r.velocity(edge, rho, ux, uy),
                 None => (ux, uy),
             };
-            src[c.idx(x, y, OPP[k])] + 6.0 * W[k] * rho * (CX[k] as f32 * ux + CY[k] as f32 * uy)
+            src.at(x, y, OPP[k]) + 6.0 * W[k] * rho * (CX[k] as f32 * ux + CY[k] as f32 * uy)
         }
         Side::FreeSlip => {
             // Specular reflection: the population arriving with (cx, cy) left the neighbour
@@ -79,7 +80,7 @@ pub(crate) fn side_value(c: &KernelCtx, src: &[f32], x: usize, y: usize, k: usiz
                     (m, x, yb)
                 }
             };
-            src[c.idx(nxb, nyb, m)]
+            src.at(nxb, nyb, m)
         }
         Side::Outlet => {
             // Zero gradient across the edge, shifted to the equilibrium at rho = 1.
@@ -90,7 +91,7 @@ pub(crate) fn side_value(c: &KernelCtx, src: &[f32], x: usize, y: usize, k: usiz
             let (xc, yc) = if c.solid[yc * c.nx + xc] { (x, y) } else { (xc, yc) };
             let mut g = [0.0f32; Q];
             for (i, gi) in g.iter_mut().enumerate() {
-                *gi = src[c.idx(xc, yc, i)];
+                *gi = src.at(xc, yc, i);
             }
             let (drho, jx, jy) = moments(&g);
             let rho = 1.0 + drho;
