@@ -14,7 +14,7 @@ fn forces_by_hand(env: &LbmEnv) -> Vec<[f64; 2]> {
     let setup: FlowSetup = env.spec().flow_setup();
     let plan = setup.plan(Level::Coarse).unwrap();
     let mut twin = setup.build(&plan).unwrap().into_uniform().unwrap();
-    twin.set_populations(env.solver().populations(), env.solver().time()).unwrap();
+    twin.set_populations(&env.solver().populations(), env.solver().time()).unwrap();
     let n = env.steps_per_action();
     let mut sum = vec![[0.0f64; 2]; setup.bodies.len()];
     for _ in 0..n {
